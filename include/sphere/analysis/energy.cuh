@@ -1,0 +1,97 @@
+#pragma once
+/// \file
+/// Energy and momentum diagnostics (docs/physics.md, "Energy budget").
+#include <cstddef>
+
+#include "../boundary/walls.cuh"
+#include "../boundary/world.cuh"
+#include "../contact/contact_lists.cuh"
+#include "../contact/params.cuh"
+#include "../particles/state.cuh"
+
+namespace sphere {
+
+/// Energies of the whole assembly (J) and dissipation rates (W).
+template <class Real>
+struct energy_budget {
+    Real kinetic = 0;         ///< sum m |v|^2 / 2
+    Real rotational = 0;      ///< sum I |omega|^2 / 2, I = 2/5 m r^2
+    Real potential = 0;       ///< sum -m g . x (zero at the origin)
+    Real elastic = 0;         ///< energy stored in the contact springs, normal and tangential
+    Real dissipated_visc = 0; ///< total viscous dissipation so far
+    Real dissipated_fric = 0; ///< total frictional dissipation so far
+    Real rate_visc = 0;       ///< viscous dissipation rate in the last step
+    Real rate_fric = 0;       ///< frictional dissipation rate in the last step
+
+    /// Mechanical energy plus everything dissipated: constant in a closed system.
+    SPHERE_HD Real total() const
+    {
+        return kinetic + rotational + potential + elastic + dissipated_visc + dissipated_fric;
+    }
+
+    SPHERE_HD energy_budget operator+(const energy_budget& b) const
+    {
+        return {kinetic + b.kinetic,
+                rotational + b.rotational,
+                potential + b.potential,
+                elastic + b.elastic,
+                dissipated_visc + b.dissipated_visc,
+                dissipated_fric + b.dissipated_fric,
+                rate_visc + b.rate_visc,
+                rate_fric + b.rate_fric};
+    }
+};
+
+namespace detail {
+
+/// Particle i's share of the energy budget: its own energies, its dissipation, half the
+/// elastic energy of each pair contact and all of its wall contacts.
+template <class Real, class Law>
+struct particle_energy {
+    particle_view<Real> p;
+    contact_view<Real> c;
+    world<Real> box;
+    wall_set<Real> walls;
+    contact_params<Real> pair_params;
+    contact_params<Real> wall_params;
+    vec3<Real> gravity;
+
+    SPHERE_HD energy_budget<Real> operator()(std::size_t i) const
+    {
+        const vec4<Real> xi = p.x[i];
+        const Real m = p.mass[i];
+        energy_budget<Real> e;
+        e.kinetic = Real(0.5) * m * norm2(p.v[i]);
+        e.rotational = Real(0.2) * m * xi.w * xi.w * norm2(p.omega[i]);
+        e.potential = -m * dot(gravity, xi.xyz());
+        const unsigned listed = c.count[i] < c.capacity ? c.count[i] : static_cast<unsigned>(c.capacity);
+        for (unsigned k = 0; k < listed; ++k) {
+            const std::size_t entry = i * c.capacity + k;
+            const vec4<Real> xj = p.x[c.partner[entry]];
+            const Real delta_n = norm(box.nearest_image(xi.xyz() - xj.xyz())) - (xi.w + xj.w);
+            if (delta_n < Real(0)) e.elastic += Law::pair_energy(pair_params, delta_n, c.history[entry]) / 2;
+        }
+        for (int f = 0; f < wall_set<Real>::count; ++f) {
+            const wall_face<Real>& wall = walls.face[f];
+            if (!wall.active) continue;
+            const int a = f / 2;
+            const Real delta_n = (xi.xyz()[a] - wall.position) * wall_set<Real>::inward_normal(f)[a] - xi.w;
+            if (delta_n < Real(0))
+                e.elastic += Law::wall_energy(wall_params, delta_n, c.wall_history[i * wall_set<Real>::count + f]);
+        }
+        e.dissipated_visc = p.e_visc[i];
+        e.dissipated_fric = p.e_fric[i];
+        e.rate_visc = p.p_visc[i];
+        e.rate_fric = p.p_fric[i];
+        return e;
+    }
+};
+
+template <class Real>
+struct particle_momentum {
+    particle_view<Real> p;
+    SPHERE_HD vec3<Real> operator()(std::size_t i) const { return p.v[i] * p.mass[i]; }
+};
+
+} // namespace detail
+} // namespace sphere

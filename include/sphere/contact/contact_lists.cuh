@@ -1,0 +1,160 @@
+#pragma once
+/// \file
+/// Per-particle contact lists with history. Each particle i keeps, sorted by partner index,
+/// every j with |x_i - x_j| < r_i + r_j + skin at the last rebuild, and for each a history
+/// entry (tangential displacement, sliding flag). Entries are keyed by the user's particle
+/// indices, so the history survives the grid's reordering. Walls have one entry per face.
+///
+/// A rebuild that finds more partners than the capacity is reported by `first_overflow`;
+/// the simulation turns that into a sphere::error naming the particle: no contact is dropped
+/// silently.
+#include <cstddef>
+
+#include "../boundary/walls.cuh"
+#include "../core/vec.cuh"
+#include "../exec/algorithms.cuh"
+#include "../exec/buffer.cuh"
+#include "../exec/for_each.cuh"
+#include "../grid/neighbor_grid.cuh"
+
+namespace sphere {
+
+/// Kernel view of the contact lists.
+template <class Real>
+struct contact_view {
+    std::size_t capacity;
+    const unsigned* count;  ///< number of partners of particle i (may exceed capacity on overflow)
+    const unsigned* partner;///< partner of entry k of particle i at [i * capacity + k]
+    vec4<Real>* history;    ///< history of that entry: delta_t (m) in xyz, sliding flag in w
+    vec4<Real>* wall_history; ///< history of particle i against wall face f at [i * 6 + f]
+};
+
+namespace detail {
+/// Builds particle i's new partner list from the grid and carries over the history of
+/// partners that were already listed.
+template <class Real>
+struct build_contact_list {
+    grid_view<Real> grid;
+    const vec4<Real>* x;
+    Real skin;
+    std::size_t capacity;
+    const unsigned* old_count;
+    const unsigned* old_partner;
+    const vec4<Real>* old_history;
+    unsigned* count;
+    unsigned* partner;
+    vec4<Real>* history;
+
+    SPHERE_HD void operator()(std::size_t i) const
+    {
+        const grid_geometry<Real>& g = grid.geometry;
+        const vec4<Real> xi = x[i];
+        const int ci[3] = {g.coordinate(xi.x, 0), g.coordinate(xi.y, 1), g.coordinate(xi.z, 2)};
+        unsigned* mine = partner + i * capacity;
+        unsigned found = 0;
+        for (int dz = -1; dz <= 1; ++dz)
+            for (int dy = -1; dy <= 1; ++dy)
+                for (int dx = -1; dx <= 1; ++dx) {
+                    const int d[3] = {dx, dy, dz};
+                    int c[3];
+                    bool inside = true;
+                    for (int a = 0; a < 3; ++a) {
+                        c[a] = ci[a] + d[a];
+                        const int na = static_cast<int>(g.n[a]);
+                        if (g.box.periodic(a)) c[a] = (c[a] + na) % na;
+                        else if (c[a] < 0 || c[a] >= na) inside = false;
+                    }
+                    if (!inside) continue;
+                    const unsigned cell = g.index(c[0], c[1], c[2]);
+                    const unsigned start = grid.cell_start[cell];
+                    if (start == grid_view<Real>::empty_cell) continue;
+                    for (unsigned k = start; k < grid.cell_end[cell]; ++k) {
+                        const unsigned j = grid.order[k];
+                        if (j == i) continue;
+                        const vec4<Real> xj = grid.sorted_x[k];
+                        const Real reach = xi.w + xj.w + skin;
+                        if (norm2(g.box.nearest_image(xi.xyz() - xj.xyz())) < reach * reach) {
+                            if (found < capacity) mine[found] = j;
+                            ++found;
+                        }
+                    }
+                }
+        count[i] = found;
+        const unsigned kept = found < capacity ? found : static_cast<unsigned>(capacity);
+        for (unsigned a = 1; a < kept; ++a) { // insertion sort by partner index: lists are short
+            const unsigned v = mine[a];
+            unsigned b = a;
+            for (; b > 0 && mine[b - 1] > v; --b) mine[b] = mine[b - 1];
+            mine[b] = v;
+        }
+        const unsigned* before = old_partner + i * capacity;
+        const unsigned old_kept = old_count[i] < capacity ? old_count[i] : static_cast<unsigned>(capacity);
+        unsigned m = 0;
+        for (unsigned a = 0; a < kept; ++a) {
+            while (m < old_kept && before[m] < mine[a]) ++m;
+            history[i * capacity + a] =
+                (m < old_kept && before[m] == mine[a]) ? old_history[i * capacity + m] : vec4<Real>{0, 0, 0, 0};
+        }
+    }
+};
+
+struct overflow_index {
+    const unsigned* count;
+    std::size_t capacity;
+    SPHERE_HD std::size_t operator()(std::size_t i) const { return count[i] > capacity ? i : ~std::size_t(0); }
+};
+} // namespace detail
+
+template <class Real, class Policy>
+class contact_lists {
+public:
+    contact_lists() = default;
+    contact_lists(std::size_t n, std::size_t capacity)
+        : capacity_(capacity), count_(n, 0u), partner_(n * capacity, 0u), history_(n * capacity),
+          wall_history_(n * wall_set<Real>::count, vec4<Real>{0, 0, 0, 0}), new_count_(n, 0u),
+          new_partner_(n * capacity, 0u), new_history_(n * capacity)
+    {
+    }
+
+    std::size_t capacity() const { return capacity_; }
+    std::size_t size() const { return count_.size(); }
+
+    /// Rebuilds every list from a built grid; returns the first particle whose partners
+    /// exceed the capacity, or ~0 when none does.
+    std::size_t rebuild(const grid_view<Real>& grid, const vec4<Real>* x, Real skin)
+    {
+        const std::size_t n = count_.size();
+        for_each_index(Policy{}, n,
+                       detail::build_contact_list<Real>{grid, x, skin, capacity_, count_.data(), partner_.data(),
+                                                        history_.data(), new_count_.data(), new_partner_.data(),
+                                                        new_history_.data()});
+        count_.swap(new_count_);
+        partner_.swap(new_partner_);
+        history_.swap(new_history_);
+        return transform_reduce(Policy{}, n, detail::overflow_index{count_.data(), capacity_}, ~std::size_t(0),
+                                min_op{});
+    }
+
+    /// Number of partners listed for particle i (host copy; for diagnostics and errors).
+    unsigned count_of(std::size_t i) const { return count_.to_host()[i]; }
+
+    contact_view<Real> view()
+    {
+        return {capacity_, count_.data(), partner_.data(), history_.data(), wall_history_.data()};
+    }
+
+    /// Host copies for checkpoints and tests.
+    std::vector<unsigned> counts() const { return count_.to_host(); }
+    std::vector<unsigned> partners() const { return partner_.to_host(); }
+    std::vector<vec4<Real>> histories() const { return history_.to_host(); }
+    std::vector<vec4<Real>> wall_histories() const { return wall_history_.to_host(); }
+
+private:
+    std::size_t capacity_ = 0;
+    buffer<unsigned, Policy> count_, partner_;
+    buffer<vec4<Real>, Policy> history_, wall_history_;
+    buffer<unsigned, Policy> new_count_, new_partner_;
+    buffer<vec4<Real>, Policy> new_history_;
+};
+
+} // namespace sphere

@@ -1,0 +1,96 @@
+#pragma once
+/// \file
+/// The interaction kernel: each particle gathers the forces and torques of its listed
+/// partners and of the walls it touches, with no atomics, so results are deterministic.
+/// Each pair is evaluated from both sides; each side books half of the pair's dissipation.
+#include <cstddef>
+
+#include "../boundary/walls.cuh"
+#include "../boundary/world.cuh"
+#include "../particles/state.cuh"
+#include "contact_lists.cuh"
+#include "params.cuh"
+#include "result.cuh"
+
+namespace sphere {
+namespace detail {
+
+template <class Real, class Law>
+struct interact {
+    particle_view<Real> p;
+    contact_view<Real> c;
+    world<Real> box;
+    wall_set<Real> walls;
+    contact_params<Real> pair_params;
+    contact_params<Real> wall_params;
+    Real dt;
+
+    SPHERE_HD void operator()(std::size_t i) const
+    {
+        const vec4<Real> xi = p.x[i];
+        const vec3<Real> vi = p.v[i];
+        const vec3<Real> wi = p.omega[i];
+        vec3<Real> force{0, 0, 0}, torque{0, 0, 0};
+        Real fn_sum = 0, visc = 0, fric = 0;
+
+        const unsigned listed = c.count[i] < c.capacity ? c.count[i] : static_cast<unsigned>(c.capacity);
+        for (unsigned k = 0; k < listed; ++k) {
+            const std::size_t e = i * c.capacity + k;
+            const unsigned j = c.partner[e];
+            const vec4<Real> xj = p.x[j];
+            const vec3<Real> d = box.nearest_image(xi.xyz() - xj.xyz());
+            const Real dist = norm(d);
+            const Real delta_n = dist - (xi.w + xj.w);
+            vec4<Real> h = c.history[e];
+            if (delta_n < Real(0) && dist > Real(0)) {
+                const vec3<Real> n = d / dist;
+                const Real arm_i = xi.w + delta_n / 2, arm_j = xj.w + delta_n / 2;
+                const vec3<Real> vc = vi - p.v[j] + arm_i * cross(n, wi) + arm_j * cross(n, p.omega[j]);
+                const contact_result<Real> r = Law::pair(pair_params, n, delta_n, vc, h, dt);
+                force += r.normal + r.tangential;
+                torque -= arm_i * cross(n, r.tangential);
+                fn_sum += r.fn;
+                visc += r.visc_rate / 2;
+                fric += r.fric_rate / 2;
+            } else {
+                h = vec4<Real>{0, 0, 0, 0}; // a contact that has ended forgets its history
+            }
+            c.history[e] = h;
+        }
+
+        for (int f = 0; f < wall_set<Real>::count; ++f) {
+            const wall_face<Real>& wall = walls.face[f];
+            if (!wall.active) continue;
+            const std::size_t e = i * wall_set<Real>::count + static_cast<std::size_t>(f);
+            const int a = f / 2;
+            const vec3<Real> n = wall_set<Real>::inward_normal(f);
+            const Real dist = (xi.xyz()[a] - wall.position) * n[a];
+            const Real delta_n = dist - xi.w;
+            vec4<Real> h = c.wall_history[e];
+            if (delta_n < Real(0)) {
+                vec3<Real> vc = vi + dist * cross(n, wi);
+                vc[a] -= wall.velocity;
+                const contact_result<Real> r = Law::wall(wall_params, n, delta_n, vc, h, dt);
+                force += r.normal + r.tangential;
+                torque -= dist * cross(n, r.tangential);
+                fn_sum += r.fn;
+                visc += r.visc_rate;
+                fric += r.fric_rate;
+            } else {
+                h = vec4<Real>{0, 0, 0, 0};
+            }
+            c.wall_history[e] = h;
+        }
+
+        p.force[i] = force;
+        p.torque[i] = torque;
+        p.pressure[i] = fn_sum / (4 * pi<Real> * xi.w * xi.w);
+        p.p_visc[i] = visc;
+        p.p_fric[i] = fric;
+        p.e_visc[i] += visc * dt;
+        p.e_fric[i] += fric * dt;
+    }
+};
+
+} // namespace detail
+} // namespace sphere

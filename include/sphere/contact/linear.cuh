@@ -1,0 +1,131 @@
+#pragma once
+/// \file
+/// The linear (Hookean, Kelvin-Voigt) contact model as a policy type: a normal spring-dashpot
+/// and a swappable tangential law, one for particle pairs and one for walls.
+/// Equations and units: docs/physics.md, "Normal force" and "Tangential force".
+#include <cmath>
+
+#include "../core/error.cuh"
+#include "../core/vec.cuh"
+#include "params.cuh"
+#include "result.cuh"
+#include "tangential.cuh"
+
+namespace sphere {
+
+namespace contact {
+
+/// Normal force f_n = (-k_n delta_n - gamma_n d(delta_n)/dt) n, with delta_n < 0 the overlap
+/// (m), n the unit normal from the partner to this particle, and d(delta_n)/dt = v_c . n
+/// (negative while approaching). Unless tension is allowed the scalar is clipped at 0. The
+/// viscous dissipation is the work of the non-conservative part of the applied force,
+/// -(f_applied - (-k_n delta_n)) d(delta_n)/dt, which books clipping correctly
+/// (VALIDATION pitfall 3).
+template <class Real>
+struct normal_force {
+    Real magnitude;
+    Real visc_rate;
+};
+
+template <class Real>
+SPHERE_HD normal_force<Real> linear_normal(const contact_params<Real>& p, Real delta_n, Real ddelta_n)
+{
+    const Real elastic = -p.k_n * delta_n;
+    Real f = elastic - p.gamma_n * ddelta_n;
+    if (!p.tension && f < Real(0)) f = 0;
+    return {f, -(f - elastic) * ddelta_n};
+}
+
+/// The linear contact law. `PairTangential` and `WallTangential` are tangential policies
+/// (tangential::elastic_viscous_frictional or tangential::visco_frictional); the defaults
+/// follow sphere: elastic tangential springs between particles, viscous friction at walls.
+template <class PairTangential = tangential::elastic_viscous_frictional,
+          class WallTangential = tangential::visco_frictional>
+struct linear {
+    using pair_tangential = PairTangential;
+    using wall_tangential = WallTangential;
+
+    /// Throws sphere::error naming the first bad parameter.
+    template <class Real>
+    static void validate(const contact_params<Real>& pair, const contact_params<Real>& wall)
+    {
+        check(pair, "settings.contact");
+        check(wall, "settings.wall");
+        PairTangential::validate(pair, "settings.contact");
+        WallTangential::validate(wall, "settings.wall");
+    }
+
+    /// Evaluates a pair contact: delta_n < 0 the overlap (m), n the unit normal towards this
+    /// particle, vc the velocity of this particle's contact point relative to the partner's
+    /// (m/s), h the contact's history entry, dt the time step (s).
+    template <class Real>
+    SPHERE_HD static contact_result<Real> pair(const contact_params<Real>& p, const vec3<Real>& n, Real delta_n,
+                                               const vec3<Real>& vc, vec4<Real>& h, Real dt)
+    {
+        return evaluate<PairTangential>(p, n, delta_n, vc, h, dt);
+    }
+
+    /// Evaluates a wall contact, with the same meaning of the arguments (the wall is the partner).
+    template <class Real>
+    SPHERE_HD static contact_result<Real> wall(const contact_params<Real>& p, const vec3<Real>& n, Real delta_n,
+                                               const vec3<Real>& vc, vec4<Real>& h, Real dt)
+    {
+        return evaluate<WallTangential>(p, n, delta_n, vc, h, dt);
+    }
+
+    /// Elastic energy stored in a pair contact: k_n delta_n^2 / 2 plus the tangential spring (J).
+    template <class Real>
+    SPHERE_HD static Real pair_energy(const contact_params<Real>& p, Real delta_n, const vec4<Real>& h)
+    {
+        return Real(0.5) * p.k_n * delta_n * delta_n + PairTangential::stored_energy(p, h);
+    }
+
+    /// Elastic energy stored in a wall contact (J).
+    template <class Real>
+    SPHERE_HD static Real wall_energy(const contact_params<Real>& p, Real delta_n, const vec4<Real>& h)
+    {
+        return Real(0.5) * p.k_n * delta_n * delta_n + WallTangential::stored_energy(p, h);
+    }
+
+private:
+    template <class Tangential, class Real>
+    SPHERE_HD static contact_result<Real> evaluate(const contact_params<Real>& p, const vec3<Real>& n, Real delta_n,
+                                                   const vec3<Real>& vc, vec4<Real>& h, Real dt)
+    {
+        const Real ddelta_n = dot(vc, n);
+        const normal_force<Real> fn = linear_normal(p, delta_n, ddelta_n);
+        const vec3<Real> vt = vc - n * ddelta_n;
+        const tangential_force<Real> ft = Tangential::evaluate(p, n, vt, fn.magnitude, h, dt);
+        contact_result<Real> out;
+        out.normal = n * fn.magnitude;
+        out.tangential = ft.force;
+        out.fn = fn.magnitude < Real(0) ? -fn.magnitude : fn.magnitude;
+        out.visc_rate = fn.visc_rate + ft.visc_rate;
+        out.fric_rate = ft.fric_rate;
+        return out;
+    }
+
+    template <class Real>
+    static void check(const contact_params<Real>& p, const char* where)
+    {
+        auto positive = [&](Real v, const char* name, const char* unit) {
+            if (!(v > 0) || !std::isfinite(v)) detail::fail(where, ".", name, " = ", v, " ", unit, ": must be positive and finite");
+        };
+        auto non_negative = [&](Real v, const char* name, const char* unit) {
+            if (!(v >= 0) || !std::isfinite(v))
+                detail::fail(where, ".", name, " = ", v, " ", unit, ": must be non-negative and finite");
+        };
+        positive(p.k_n, "k_n", "N/m");
+        non_negative(p.k_t, "k_t", "N/m");
+        non_negative(p.gamma_n, "gamma_n", "N s/m");
+        non_negative(p.gamma_t, "gamma_t", "N s/m");
+        non_negative(p.mu_s, "mu_s", "(friction)");
+        non_negative(p.mu_d, "mu_d", "(friction)");
+        if (p.mu_d > p.mu_s)
+            detail::fail(where, ".mu_d = ", p.mu_d, " exceeds ", where, ".mu_s = ", p.mu_s,
+                         ": dynamic friction must not exceed static friction");
+    }
+};
+
+} // namespace contact
+} // namespace sphere

@@ -1,0 +1,112 @@
+#pragma once
+/// \file
+/// Tangential contact laws (policy types). Each takes the contact's history entry
+/// h = (delta_t.x, delta_t.y, delta_t.z, sliding flag) and returns the tangential force on
+/// this particle with its dissipation rates. Equations: docs/physics.md, "Tangential force".
+#include <cmath>
+
+#include "../core/error.cuh"
+#include "../core/vec.cuh"
+#include "params.cuh"
+
+namespace sphere {
+
+/// The tangential part of one contact evaluation.
+template <class Real>
+struct tangential_force {
+    vec3<Real> force{0, 0, 0}; ///< f_t on this particle (N)
+    Real visc_rate = 0;        ///< power dissipated by gamma_t (W)
+    Real fric_rate = 0;        ///< power dissipated by Coulomb sliding (W)
+};
+
+namespace tangential {
+
+/// f_t = -gamma_t v_t, limited to mu |f_n| (static limit mu_s while sticking, mu_d while
+/// sliding). Keeps no displacement; only the sliding flag h.w.
+struct visco_frictional {
+    template <class Real>
+    static void validate(const contact_params<Real>&, const char*) {}
+
+    template <class Real>
+    SPHERE_HD static tangential_force<Real> evaluate(const contact_params<Real>& p, const vec3<Real>& /*n*/,
+                                                     const vec3<Real>& vt, Real fn, vec4<Real>& h, Real /*dt*/)
+    {
+        tangential_force<Real> out;
+        out.force = -p.gamma_t * vt;
+        const Real ft = norm(out.force);
+        const bool was_sliding = h.w != Real(0);
+        const Real limit = (was_sliding ? p.mu_d : p.mu_s) * fn;
+        if (ft > limit) {
+            const Real slide_limit = p.mu_d * fn;
+            out.force = out.force * (slide_limit / ft);
+            out.fric_rate = slide_limit * norm(vt);
+            h.w = 1;
+        } else {
+            out.visc_rate = p.gamma_t * norm2(vt);
+            h.w = 0;
+        }
+        return out;
+    }
+
+    template <class Real>
+    SPHERE_HD static Real stored_energy(const contact_params<Real>&, const vec4<Real>&) { return 0; }
+};
+
+/// f_t = -k_t delta_t - gamma_t v_t with the incremental tangential displacement delta_t,
+/// kept in the current contact plane (projected and rescaled to its length, so a rigid
+/// rotation of the pair rotates it without shrinking it). At the Coulomb limit the
+/// displacement is rescaled so that f_t = mu_d |f_n| t_hat:
+/// delta_t = -(mu_d |f_n| t_hat + gamma_t v_t) / k_t (VALIDATION pitfall 4: note the sign).
+struct elastic_viscous_frictional {
+    template <class Real>
+    static void validate(const contact_params<Real>& p, const char* where)
+    {
+        if (!(p.k_t > 0) || !std::isfinite(p.k_t))
+            detail::fail(where, ".k_t = ", p.k_t, " N/m: the elastic tangential law needs a positive, finite k_t");
+    }
+
+    template <class Real>
+    SPHERE_HD static tangential_force<Real> evaluate(const contact_params<Real>& p, const vec3<Real>& n,
+                                                     const vec3<Real>& vt, Real fn, vec4<Real>& h, Real dt)
+    {
+        tangential_force<Real> out;
+        // Carry the displacement into the current contact plane, keeping its length.
+        vec3<Real> d{h.x, h.y, h.z};
+        const Real len = norm(d);
+        d -= n * dot(n, d);
+        const Real len_in_plane = norm(d);
+        d = len_in_plane > Real(0) ? d * (len / len_in_plane) : vec3<Real>{0, 0, 0};
+        d += vt * dt;
+
+        out.force = -p.k_t * d - p.gamma_t * vt;
+        const Real ft = norm(out.force);
+        const bool was_sliding = h.w != Real(0);
+        const Real limit = (was_sliding ? p.mu_d : p.mu_s) * fn;
+        if (ft > limit) {
+            const Real slide_limit = p.mu_d * fn;
+            const vec3<Real> t_hat = out.force / ft;
+            const vec3<Real> slid = -(slide_limit * t_hat + p.gamma_t * vt) / p.k_t;
+            out.fric_rate = slide_limit * norm(d - slid) / dt;
+            out.force = slide_limit * t_hat;
+            d = slid;
+            h.w = 1;
+        } else {
+            out.visc_rate = p.gamma_t * norm2(vt);
+            h.w = 0;
+        }
+        h.x = d.x;
+        h.y = d.y;
+        h.z = d.z;
+        return out;
+    }
+
+    /// Elastic energy of the tangential spring, k_t |delta_t|^2 / 2 (J).
+    template <class Real>
+    SPHERE_HD static Real stored_energy(const contact_params<Real>& p, const vec4<Real>& h)
+    {
+        return Real(0.5) * p.k_t * (h.x * h.x + h.y * h.y + h.z * h.z);
+    }
+};
+
+} // namespace tangential
+} // namespace sphere

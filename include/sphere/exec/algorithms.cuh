@@ -1,0 +1,82 @@
+#pragma once
+/// \file
+/// The collective operations the step needs, one dispatch point each per policy:
+/// `sort_by_key` (stable, so equal keys keep their order and results are deterministic) and
+/// `transform_reduce` over an index range.
+///
+/// Host reductions sum fixed chunks of 4096 indices and then the chunk results in order,
+/// so a floating-point sum is bit-identical for any number of OpenMP threads.
+#include <cstddef>
+#include <vector>
+
+#include <thrust/sort.h>
+#include <thrust/system/omp/execution_policy.h>
+
+#include "../core/config.cuh"
+#include "policy.cuh"
+
+#if SPHERE_CUDA_COMPILER
+#include <thrust/execution_policy.h>
+#include <thrust/iterator/counting_iterator.h>
+#include <thrust/transform_reduce.h>
+#endif
+
+namespace sphere {
+
+/// a + b
+struct plus_op {
+    template <class T> SPHERE_HD T operator()(const T& a, const T& b) const { return a + b; }
+};
+/// max(a, b)
+struct max_op {
+    template <class T> SPHERE_HD T operator()(const T& a, const T& b) const { return a < b ? b : a; }
+};
+/// min(a, b)
+struct min_op {
+    template <class T> SPHERE_HD T operator()(const T& a, const T& b) const { return b < a ? b : a; }
+};
+
+/// Sorts `keys[0, n)` ascending and applies the same permutation to `values`; stable.
+template <class Key, class Value>
+void sort_by_key(host, Key* keys, Value* values, std::size_t n)
+{
+    thrust::stable_sort_by_key(thrust::omp::par, keys, keys + n, values);
+}
+
+/// Returns init op f(0) op f(1) ... op f(n-1), in a fixed association order.
+template <class T, class Transform, class Op>
+T transform_reduce(host, std::size_t n, const Transform& f, T init, Op op)
+{
+    constexpr std::size_t chunk = 4096;
+    const std::size_t chunks = (n + chunk - 1) / chunk;
+    std::vector<T> partial(chunks, init);
+    const long long count = static_cast<long long>(chunks);
+#pragma omp parallel for schedule(static)
+    for (long long c = 0; c < count; ++c) {
+        const std::size_t begin = static_cast<std::size_t>(c) * chunk;
+        const std::size_t end = begin + chunk < n ? begin + chunk : n;
+        T acc = f(begin);
+        for (std::size_t i = begin + 1; i < end; ++i) acc = op(acc, f(i));
+        partial[static_cast<std::size_t>(c)] = acc;
+    }
+    T result = init;
+    for (const T& p : partial) result = op(result, p);
+    return result;
+}
+
+#if SPHERE_CUDA_COMPILER
+template <class Key, class Value>
+void sort_by_key(cuda, Key* keys, Value* values, std::size_t n)
+{
+    thrust::stable_sort_by_key(thrust::device, keys, keys + n, values);
+}
+
+template <class T, class Transform, class Op>
+T transform_reduce(cuda, std::size_t n, const Transform& f, T init, Op op)
+{
+    thrust::counting_iterator<std::size_t> first(0);
+    return thrust::transform_reduce(thrust::device, first, first + n, f, init, op);
+}
+#endif
+
+} // namespace sphere

@@ -1,0 +1,71 @@
+#pragma once
+/// \file
+/// Geometry of the uniform neighbour grid over the world box.
+#include <cmath>
+#include <cstddef>
+
+#include "../boundary/world.cuh"
+#include "../core/error.cuh"
+#include "../core/vec.cuh"
+
+namespace sphere {
+
+/// A uniform grid of n[0] x n[1] x n[2] cells covering the world box. Cells are at least as
+/// wide as the contact search reach (largest diameter plus skin), so every candidate pair lies
+/// in the same or an adjacent cell.
+template <class Real>
+struct grid_geometry {
+    world<Real> box;
+    vec3<Real> width{0, 0, 0}; ///< cell widths (m)
+    unsigned n[3] = {1, 1, 1};
+
+    SPHERE_HD std::size_t cell_count() const { return std::size_t(n[0]) * n[1] * n[2]; }
+
+    /// Cell coordinate of c along axis a, clamped into the grid.
+    SPHERE_HD int coordinate(Real c, int a) const
+    {
+        const Real f = std::floor((c - box.lo[a]) / width[a]);
+        if (!(f > Real(0))) return 0;
+        if (f >= Real(n[a] - 1)) return static_cast<int>(n[a] - 1);
+        return static_cast<int>(f);
+    }
+
+    SPHERE_HD unsigned index(int ix, int iy, int iz) const
+    {
+        return (static_cast<unsigned>(iz) * n[1] + static_cast<unsigned>(iy)) * n[0] + static_cast<unsigned>(ix);
+    }
+
+    SPHERE_HD unsigned cell_of(const vec3<Real>& p) const
+    {
+        return index(coordinate(p.x, 0), coordinate(p.y, 1), coordinate(p.z, 2));
+    }
+
+    /// Lays a grid over `box` with cells at least `reach` (m) wide, or exactly `requested` wide
+    /// per axis when it is positive (rounded down to fit the box). Throws when a requested cell
+    /// is narrower than `reach`, when a periodic axis has fewer than 3 cells, or when the grid
+    /// would exceed 2^28 cells.
+    static grid_geometry make(const world<Real>& box, Real reach, Real requested)
+    {
+        if (requested > 0 && requested < reach)
+            detail::fail("settings.cell_size = ", requested, " m is smaller than the largest particle diameter plus skin, ",
+                         reach, " m: contacts would be missed");
+        const Real target = requested > 0 ? requested : reach;
+        grid_geometry g;
+        g.box = box;
+        for (int a = 0; a < 3; ++a) {
+            const Real cells = std::floor(box.length(a) / target);
+            g.n[a] = cells < 1 ? 1u : static_cast<unsigned>(cells < Real(1 << 20) ? cells : Real(1 << 20));
+            g.width[a] = box.length(a) / Real(g.n[a]);
+            if (box.periodic(a) && g.n[a] < 3)
+                detail::fail("periodic axis ", a, " of length ", box.length(a), " m holds ", g.n[a],
+                             " grid cells of at least ", target,
+                             " m: a periodic axis needs at least 3 (make the world wider or the particles smaller)");
+        }
+        if (g.cell_count() > (std::size_t(1) << 28))
+            detail::fail("the neighbour grid would need ", g.cell_count(), " cells (", g.n[0], " x ", g.n[1], " x ",
+                         g.n[2], "); set settings.cell_size larger or shrink the world");
+        return g;
+    }
+};
+
+} // namespace sphere

@@ -1,0 +1,83 @@
+#pragma once
+/// \file
+/// The integration kernel and the post-step check of every particle.
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+
+#include "../boundary/world.cuh"
+#include "../particles/state.cuh"
+
+namespace sphere {
+namespace detail {
+
+/// Advances particle i by dt: free particles under contact force, torque and gravity with the
+/// integrator policy (moment of inertia 2/5 m r^2), prescribed ones at their own velocities,
+/// fixed ones not at all. Coordinates on periodic axes are wrapped back into the box.
+template <class Real, class Integrator>
+struct integrate_particles {
+    particle_view<Real> p;
+    world<Real> box;
+    vec3<Real> gravity;
+    Real dt;
+
+    SPHERE_HD void operator()(std::size_t i) const
+    {
+        const auto kind = static_cast<motion>(p.kind[i]);
+        if (kind == motion::fixed) return;
+        vec4<Real> x = p.x[i];
+        vec3<Real> pos = x.xyz();
+        vec3<Real> v = p.v[i], w = p.omega[i], ang = p.angpos[i];
+        if (kind == motion::free) {
+            const Real m = p.mass[i];
+            const Real inertia = Real(0.4) * m * x.w * x.w;
+            Integrator::advance(pos, v, p.force[i] / m + gravity, dt);
+            Integrator::advance(ang, w, p.torque[i] / inertia, dt);
+        } else {
+            pos += v * dt;
+            ang += w * dt;
+        }
+        p.x[i] = {box.wrap(pos.x, 0), box.wrap(pos.y, 1), box.wrap(pos.z, 2), x.w};
+        p.v[i] = v;
+        p.omega[i] = w;
+        p.angpos[i] = ang;
+    }
+};
+
+/// Result of the post-step check: the largest squared displacement since the contact lists
+/// were built (m^2), and the first particle that is non-finite or outside the world on a wall
+/// axis (~0 when none is).
+template <class Real>
+struct step_check {
+    Real max_displacement2;
+    std::size_t first_bad;
+};
+
+struct combine_checks {
+    template <class Real>
+    SPHERE_HD step_check<Real> operator()(const step_check<Real>& a, const step_check<Real>& b) const
+    {
+        return {a.max_displacement2 < b.max_displacement2 ? b.max_displacement2 : a.max_displacement2,
+                b.first_bad < a.first_bad ? b.first_bad : a.first_bad};
+    }
+};
+
+template <class Real>
+struct check_particle {
+    particle_view<Real> p;
+    const vec4<Real>* x_at_build;
+    world<Real> box;
+
+    SPHERE_HD step_check<Real> operator()(std::size_t i) const
+    {
+        const vec3<Real> pos = p.x[i].xyz();
+        bool bad = !isfinite(pos) || !isfinite(p.v[i]) || !isfinite(p.omega[i]);
+        for (int a = 0; a < 3; ++a)
+            if (!box.periodic(a) && !(pos[a] >= box.lo[a] && pos[a] <= box.hi[a])) bad = true;
+        const Real moved = norm2(box.nearest_image(pos - x_at_build[i].xyz()));
+        return {bad ? Real(0) : moved, bad ? i : ~std::size_t(0)};
+    }
+};
+
+} // namespace detail
+} // namespace sphere

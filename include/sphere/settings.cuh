@@ -1,0 +1,24 @@
+#pragma once
+/// \file
+/// Everything a DEM simulation needs besides its particles.
+#include <cstddef>
+
+#include "boundary/world.cuh"
+#include "contact/params.cuh"
+#include "core/vec.cuh"
+
+namespace sphere {
+
+template <class Real>
+struct settings {
+    world<Real> box;                ///< world box and per-axis boundaries
+    contact_params<Real> contact;   ///< particle-particle contacts
+    contact_params<Real> wall;      ///< particle-wall contacts (sphere's k_n, gamma_wn, gamma_wt, mu_ws, mu_wd)
+    vec3<Real> gravity{0, 0, 0};    ///< (m/s^2)
+    Real dt = 0;                    ///< time step (s); 0 selects 0.075 min sqrt(m / max(k_n, k_t))
+    Real skin = 0;                  ///< contact-list skin (m); 0 rebuilds the lists every step, as sphere
+    std::size_t contact_capacity = 32; ///< partners listed per particle (within r_i + r_j + skin)
+    Real cell_size = 0;             ///< neighbour-grid cell width (m); 0 selects the largest diameter plus skin
+};
+
+} // namespace sphere

@@ -1,0 +1,229 @@
+#pragma once
+/// \file
+/// `simulation`: composes particles, the neighbour grid, the contact lists, a contact law and
+/// an integrator into sphere's DEM step, with observers and diagnostics.
+#include <cmath>
+#include <cstddef>
+#include <functional>
+#include <utility>
+#include <vector>
+
+#include "analysis/energy.cuh"
+#include "boundary/walls.cuh"
+#include "contact/contact_lists.cuh"
+#include "contact/interact.cuh"
+#include "contact/linear.cuh"
+#include "core/error.cuh"
+#include "exec/algorithms.cuh"
+#include "exec/for_each.cuh"
+#include "grid/neighbor_grid.cuh"
+#include "integrate/integrate_particles.cuh"
+#include "integrate/integrators.cuh"
+#include "integrate/time_step.cuh"
+#include "particles/state.cuh"
+#include "particles/validate.cuh"
+#include "settings.cuh"
+
+namespace sphere {
+
+namespace detail {
+template <class Real>
+struct copy_positions {
+    const vec4<Real>* from;
+    vec4<Real>* to;
+    SPHERE_HD void operator()(std::size_t i) const { to[i] = from[i]; }
+};
+
+template <class Real>
+struct set_kinematics {
+    particle_view<Real> p;
+    std::size_t index;
+    vec3<Real> v, omega;
+    SPHERE_HD void operator()(std::size_t) const
+    {
+        p.v[index] = v;
+        p.omega[index] = omega;
+    }
+};
+} // namespace detail
+
+/// A DEM simulation of spheres.
+///
+/// \tparam Real       float or double
+/// \tparam Policy     sphere::host or sphere::cuda
+/// \tparam Law        contact law policy, e.g. contact::linear<tangential::visco_frictional>
+/// \tparam Integrator integrate::semi_implicit_euler (default), taylor2 or explicit_euler
+///
+/// One step: rebuild the grid and contact lists when some particle has moved more than half
+/// the skin since the last rebuild (every step with skin 0); every particle gathers contact
+/// forces; integrate; check every particle (a non-finite value or a particle outside the world
+/// on a wall axis stops the run with a sphere::error naming the step and the particle); advance
+/// time; call the observers that are due.
+template <class Real, class Policy = host, class Law = contact::linear<>,
+          class Integrator = integrate::semi_implicit_euler>
+class simulation {
+public:
+    using real_type = Real;
+    using policy_type = Policy;
+    using observer = std::function<void(const simulation&)>;
+
+    /// Validates everything and builds the first contact lists; throws sphere::error on bad input.
+    simulation(const settings<Real>& s, std::vector<particle<Real>> particles) : settings_(s)
+    {
+        validate_world(s.box);
+        Law::validate(s.contact, s.wall);
+        if (!isfinite(s.gravity))
+            detail::fail("settings.gravity (", s.gravity.x, ", ", s.gravity.y, ", ", s.gravity.z, ") m/s^2 is not finite");
+        if (!(s.skin >= 0) || !std::isfinite(s.skin))
+            detail::fail("settings.skin = ", s.skin, " m: must be non-negative and finite");
+        if (s.contact_capacity < 1) detail::fail("settings.contact_capacity = 0: must be at least 1");
+        if (!(s.cell_size >= 0) || !std::isfinite(s.cell_size))
+            detail::fail("settings.cell_size = ", s.cell_size, " m: must be non-negative and finite (0 = automatic)");
+        if (particles.empty()) detail::fail("no particles: a simulation needs at least one");
+        validate_particles(particles, s.box);
+
+        Real min_mass = 0, max_radius = 0;
+        for (std::size_t i = 0; i < particles.size(); ++i) {
+            particle<Real>& p = particles[i];
+            for (int a = 0; a < 3; ++a) p.position[a] = s.box.wrap(p.position[a], a);
+            const Real m = sphere_mass(p.radius, p.density);
+            min_mass = i == 0 || m < min_mass ? m : min_mass;
+            max_radius = p.radius > max_radius ? p.radius : max_radius;
+        }
+        const Real bound = stable_time_step_bound(min_mass, s.contact, s.wall);
+        if (s.dt == Real(0)) {
+            dt_ = default_time_step(min_mass, s.contact, s.wall);
+        } else if (!(s.dt > 0) || !std::isfinite(s.dt)) {
+            detail::fail("settings.dt = ", s.dt, " s: must be positive and finite (0 = automatic)");
+        } else if (s.dt > bound) {
+            detail::fail("settings.dt = ", s.dt, " s exceeds the stable bound 0.3 sqrt(m_min / k_max) = ", bound,
+                         " s (m_min = ", min_mass, " kg, k_max = ", stiffest(s.contact, s.wall), " N/m)");
+        } else {
+            dt_ = s.dt;
+        }
+
+        particles_ = particle_state<Real, Policy>(particles);
+        walls_ = wall_set<Real>::from_world(s.box);
+        grid_ = neighbor_grid<Real, Policy>(grid_geometry<Real>::make(s.box, 2 * max_radius + s.skin, s.cell_size));
+        lists_ = contact_lists<Real, Policy>(particles.size(), s.contact_capacity);
+        x_at_build_.resize(particles.size());
+        rebuild_lists();
+    }
+
+    /// One DEM step of length dt().
+    void step()
+    {
+        if (needs_rebuild_) rebuild_lists();
+        particle_view<Real> p = particles_.view();
+        const std::size_t n = p.n;
+        for_each_index(Policy{}, n,
+                       detail::interact<Real, Law>{p, lists_.view(), settings_.box, walls_, settings_.contact,
+                                                   settings_.wall, dt_});
+        for_each_index(Policy{}, n, detail::integrate_particles<Real, Integrator>{p, settings_.box, settings_.gravity, dt_});
+        const detail::step_check<Real> check = transform_reduce(
+            Policy{}, n, detail::check_particle<Real>{p, x_at_build_.data(), settings_.box},
+            detail::step_check<Real>{0, ~std::size_t(0)}, detail::combine_checks{});
+        ++steps_;
+        time_ = static_cast<double>(steps_) * static_cast<double>(dt_);
+        if (check.first_bad != ~std::size_t(0)) report_bad_particle(check.first_bad);
+        needs_rebuild_ = 4 * check.max_displacement2 > settings_.skin * settings_.skin;
+        for (const auto& o : observers_)
+            if (steps_ % o.first == 0) o.second(*this);
+    }
+
+    /// Runs `count` steps.
+    void run(std::size_t count)
+    {
+        for (std::size_t k = 0; k < count; ++k) step();
+    }
+
+    /// Calls `f(*this)` after every `every`-th step.
+    void add_observer(std::size_t every, observer f)
+    {
+        if (every == 0) detail::fail("observer interval 0: must be at least 1 step");
+        observers_.emplace_back(every, std::move(f));
+    }
+
+    /// Sets the velocity (m/s) and angular velocity (rad/s) of particle i; a prescribed
+    /// particle keeps them until set again.
+    void set_velocity(std::size_t i, const vec3<Real>& v, const vec3<Real>& omega)
+    {
+        if (i >= size()) detail::fail("set_velocity: particle index ", i, " out of range (", size(), " particles)");
+        for_each_index(Policy{}, 1, detail::set_kinematics<Real>{particles_.view(), i, v, omega});
+    }
+
+    std::size_t size() const { return particles_.size(); }
+    Real dt() const { return dt_; }
+    /// Simulated time (s), steps() * dt() in double.
+    double time() const { return time_; }
+    std::size_t steps() const { return steps_; }
+    /// How many times the grid and contact lists were built (including at setup).
+    std::size_t rebuilds() const { return rebuilds_; }
+    const settings<Real>& config() const { return settings_; }
+    const wall_set<Real>& walls() const { return walls_; }
+    const grid_geometry<Real>& grid() const { return grid_.geometry(); }
+
+    /// A host copy of every particle field.
+    particle_snapshot<Real> snapshot() const { return particles_.snapshot(); }
+    const contact_lists<Real, Policy>& contacts() const { return lists_; }
+
+    /// Kinetic, rotational, potential and elastic energies and the dissipated energies (J).
+    energy_budget<Real> energy() const
+    {
+        auto& self = const_cast<simulation&>(*this); // views hand out mutable pointers; nothing is written
+        return transform_reduce(Policy{}, size(),
+                                detail::particle_energy<Real, Law>{self.particles_.view(), self.lists_.view(),
+                                                                   settings_.box, walls_, settings_.contact,
+                                                                   settings_.wall, settings_.gravity},
+                                energy_budget<Real>{}, plus_op{});
+    }
+
+    /// Total linear momentum, sum m v (kg m/s).
+    vec3<Real> momentum() const
+    {
+        auto& self = const_cast<simulation&>(*this);
+        return transform_reduce(Policy{}, size(), detail::particle_momentum<Real>{self.particles_.view()},
+                                vec3<Real>{0, 0, 0}, plus_op{});
+    }
+
+private:
+    void rebuild_lists()
+    {
+        particle_view<Real> p = particles_.view();
+        grid_.build(p);
+        const std::size_t overflow = lists_.rebuild(grid_.view(), p.x, settings_.skin);
+        ++rebuilds_;
+        if (overflow != ~std::size_t(0))
+            detail::fail("step ", steps_, ": particle ", overflow, " has ", lists_.count_of(overflow),
+                         " neighbours within r_i + r_j + skin, more than settings.contact_capacity = ",
+                         lists_.capacity(), "; raise the capacity");
+        for_each_index(Policy{}, p.n, detail::copy_positions<Real>{p.x, x_at_build_.data()});
+        needs_rebuild_ = false;
+    }
+
+    [[noreturn]] void report_bad_particle(std::size_t i) const
+    {
+        const particle_snapshot<Real> s = particles_.snapshot();
+        const vec3<Real> x = s.position(i), v = s.v[i];
+        if (!isfinite(x) || !isfinite(v) || !isfinite(s.omega[i]))
+            detail::fail("step ", steps_, ": particle ", i, " became non-finite (position (", x.x, ", ", x.y, ", ",
+                         x.z, ") m, velocity (", v.x, ", ", v.y, ", ", v.z, ") m/s); reduce the time step");
+        detail::fail("step ", steps_, ": particle ", i, " left the world: position (", x.x, ", ", x.y, ", ", x.z,
+                     ") m, world [", settings_.box.lo.x, ", ", settings_.box.hi.x, "] x [", settings_.box.lo.y, ", ",
+                     settings_.box.hi.y, "] x [", settings_.box.lo.z, ", ", settings_.box.hi.z, "] m");
+    }
+
+    settings<Real> settings_;
+    Real dt_ = 0;
+    double time_ = 0;
+    std::size_t steps_ = 0, rebuilds_ = 0;
+    bool needs_rebuild_ = true;
+    particle_state<Real, Policy> particles_;
+    wall_set<Real> walls_;
+    neighbor_grid<Real, Policy> grid_;
+    contact_lists<Real, Policy> lists_;
+    buffer<vec4<Real>, Policy> x_at_build_;
+    std::vector<std::pair<std::size_t, observer>> observers_;
+};
+
+} // namespace sphere
