@@ -43,6 +43,8 @@ struct set_kinematics {
     {
         p.v[index] = v;
         p.omega[index] = omega;
+        p.v_sync[index] = v;
+        p.omega_sync[index] = omega;
     }
 };
 } // namespace detail
@@ -204,8 +206,8 @@ private:
     [[noreturn]] void report_bad_particle(std::size_t i) const
     {
         const particle_snapshot<Real> s = particles_.snapshot();
-        const vec3<Real> x = s.position(i), v = s.v[i];
-        if (!isfinite(x) || !isfinite(v) || !isfinite(s.omega[i]))
+        const vec3<Real> x = s.position(i), v = s.v_sync[i];
+        if (!isfinite(x) || !isfinite(v) || !isfinite(s.omega_sync[i]))
             detail::fail("step ", steps_, ": particle ", i, " became non-finite (position (", x.x, ", ", x.y, ", ",
                          x.z, ") m, velocity (", v.x, ", ", v.y, ", ", v.z, ") m/s); reduce the time step");
         detail::fail("step ", steps_, ": particle ", i, " left the world: position (", x.x, ", ", x.y, ", ", x.z,

@@ -1,6 +1,7 @@
 #pragma once
 /// \file
-/// Energy and momentum diagnostics (docs/physics.md, "Energy budget").
+/// Energy and momentum diagnostics (docs/physics.md, "Energy budget"), from the velocities at
+/// the time of the positions.
 #include <cstddef>
 
 #include "../boundary/walls.cuh"
@@ -61,8 +62,8 @@ struct particle_energy {
         const vec4<Real> xi = p.x[i];
         const Real m = p.mass[i];
         energy_budget<Real> e;
-        e.kinetic = Real(0.5) * m * norm2(p.v[i]);
-        e.rotational = Real(0.2) * m * xi.w * xi.w * norm2(p.omega[i]);
+        e.kinetic = Real(0.5) * m * norm2(p.v_sync[i]);
+        e.rotational = Real(0.2) * m * xi.w * xi.w * norm2(p.omega_sync[i]);
         e.potential = -m * dot(gravity, xi.xyz());
         const unsigned listed = c.count[i] < c.capacity ? c.count[i] : static_cast<unsigned>(c.capacity);
         for (unsigned k = 0; k < listed; ++k) {
@@ -90,7 +91,7 @@ struct particle_energy {
 template <class Real>
 struct particle_momentum {
     particle_view<Real> p;
-    SPHERE_HD vec3<Real> operator()(std::size_t i) const { return p.v[i] * p.mass[i]; }
+    SPHERE_HD vec3<Real> operator()(std::size_t i) const { return p.v_sync[i] * p.mass[i]; }
 };
 
 } // namespace detail

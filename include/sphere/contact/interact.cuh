@@ -28,8 +28,8 @@ struct interact {
     SPHERE_HD void operator()(std::size_t i) const
     {
         const vec4<Real> xi = p.x[i];
-        const vec3<Real> vi = p.v[i];
-        const vec3<Real> wi = p.omega[i];
+        const vec3<Real> vi = p.v_sync[i];
+        const vec3<Real> wi = p.omega_sync[i];
         vec3<Real> force{0, 0, 0}, torque{0, 0, 0};
         Real fn_sum = 0, visc = 0, fric = 0;
 
@@ -45,7 +45,7 @@ struct interact {
             if (delta_n < Real(0) && dist > Real(0)) {
                 const vec3<Real> n = d / dist;
                 const Real arm_i = xi.w + delta_n / 2, arm_j = xj.w + delta_n / 2;
-                const vec3<Real> vc = vi - p.v[j] + arm_i * cross(n, wi) + arm_j * cross(n, p.omega[j]);
+                const vec3<Real> vc = vi - p.v_sync[j] + arm_i * cross(n, wi) + arm_j * cross(n, p.omega_sync[j]);
                 const contact_result<Real> r = Law::pair(pair_params, n, delta_n, vc, h, dt);
                 force += r.normal + r.tangential;
                 torque -= arm_i * cross(n, r.tangential);

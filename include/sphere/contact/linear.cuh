@@ -95,11 +95,12 @@ private:
         const Real ddelta_n = dot(vc, n);
         const normal_force<Real> fn = linear_normal(p, delta_n, ddelta_n);
         const vec3<Real> vt = vc - n * ddelta_n;
-        const tangential_force<Real> ft = Tangential::evaluate(p, n, vt, fn.magnitude, h, dt);
+        const Real fn_abs = fn.magnitude < Real(0) ? -fn.magnitude : fn.magnitude; // < 0 only with tension
+        const tangential_force<Real> ft = Tangential::evaluate(p, n, vt, fn_abs, h, dt);
         contact_result<Real> out;
         out.normal = n * fn.magnitude;
         out.tangential = ft.force;
-        out.fn = fn.magnitude < Real(0) ? -fn.magnitude : fn.magnitude;
+        out.fn = fn_abs;
         out.visc_rate = fn.visc_rate + ft.visc_rate;
         out.fric_rate = ft.fric_rate;
         return out;

@@ -13,7 +13,7 @@ namespace detail {
 
 /// Advances particle i by dt: free particles under contact force, torque and gravity with the
 /// integrator policy (moment of inertia 2/5 m r^2), prescribed ones at their own velocities,
-/// fixed ones not at all. Coordinates on periodic axes are wrapped back into the box.
+/// fixed ones not at all. Also stores the velocities at the new positions' time. Coordinates on periodic axes are wrapped back into the box.
 template <class Real, class Integrator>
 struct integrate_particles {
     particle_view<Real> p;
@@ -28,11 +28,15 @@ struct integrate_particles {
         vec4<Real> x = p.x[i];
         vec3<Real> pos = x.xyz();
         vec3<Real> v = p.v[i], w = p.omega[i], ang = p.angpos[i];
+        vec3<Real> v_sync = v, w_sync = w;
         if (kind == motion::free) {
             const Real m = p.mass[i];
             const Real inertia = Real(0.4) * m * x.w * x.w;
-            Integrator::advance(pos, v, p.force[i] / m + gravity, dt);
-            Integrator::advance(ang, w, p.torque[i] / inertia, dt);
+            const vec3<Real> a = p.force[i] / m + gravity, alpha = p.torque[i] / inertia;
+            Integrator::advance(pos, v, a, dt);
+            Integrator::advance(ang, w, alpha, dt);
+            v_sync = Integrator::synchronous_velocity(v, a, dt);
+            w_sync = Integrator::synchronous_velocity(w, alpha, dt);
         } else {
             pos += v * dt;
             ang += w * dt;
@@ -40,6 +44,8 @@ struct integrate_particles {
         p.x[i] = {box.wrap(pos.x, 0), box.wrap(pos.y, 1), box.wrap(pos.z, 2), x.w};
         p.v[i] = v;
         p.omega[i] = w;
+        p.v_sync[i] = v_sync;
+        p.omega_sync[i] = w_sync;
         p.angpos[i] = ang;
     }
 };
@@ -71,7 +77,7 @@ struct check_particle {
     SPHERE_HD step_check<Real> operator()(std::size_t i) const
     {
         const vec3<Real> pos = p.x[i].xyz();
-        bool bad = !isfinite(pos) || !isfinite(p.v[i]) || !isfinite(p.omega[i]);
+        bool bad = !isfinite(pos) || !isfinite(p.v_sync[i]) || !isfinite(p.omega_sync[i]);
         for (int a = 0; a < 3; ++a)
             if (!box.periodic(a) && !(pos[a] >= box.lo[a] && pos[a] <= box.hi[a])) bad = true;
         const Real moved = norm2(box.nearest_image(pos - x_at_build[i].xyz()));

@@ -2,7 +2,9 @@
 /// \file
 /// Explicit time integrators (policy types). Each advances one degree of freedom (a position
 /// and its velocity, or an angular position and its angular velocity) by dt under a constant
-/// acceleration a. Errors at the default time step: docs/physics.md, "Integration".
+/// acceleration a, and says what the velocity is at the time of the new position (contact
+/// laws and diagnostics use that one). Errors at the default time step: docs/physics.md,
+/// "Integration".
 #include "../core/vec.cuh"
 
 namespace sphere {
@@ -17,6 +19,14 @@ struct semi_implicit_euler {
         v += a * dt;
         x += v * dt;
     }
+
+    /// v is the mid-step velocity v(t + dt/2); the velocity at the new position's time is
+    /// v + a dt / 2 up to O(dt^2) (a from the step just taken).
+    template <class Real>
+    SPHERE_HD static vec3<Real> synchronous_velocity(const vec3<Real>& v, const vec3<Real>& a, Real dt)
+    {
+        return v + a * (dt / 2);
+    }
 };
 
 /// sphere's second-order Taylor scheme: x += v dt + a dt^2 / 2; v += a dt. Creates energy in
@@ -28,6 +38,12 @@ struct taylor2 {
         x += v * dt + a * (dt * dt / 2);
         v += a * dt;
     }
+
+    template <class Real>
+    SPHERE_HD static vec3<Real> synchronous_velocity(const vec3<Real>& v, const vec3<Real>&, Real)
+    {
+        return v;
+    }
 };
 
 /// Explicit (forward) Euler: x += v dt; v += a dt. Creates energy (e = 1.181 for an elastic
@@ -38,6 +54,12 @@ struct explicit_euler {
     {
         x += v * dt;
         v += a * dt;
+    }
+
+    template <class Real>
+    SPHERE_HD static vec3<Real> synchronous_velocity(const vec3<Real>& v, const vec3<Real>&, Real)
+    {
+        return v;
     }
 };
 

@@ -21,6 +21,8 @@ struct particle_view {
     vec4<Real>* x;          ///< position (m) in xyz, radius (m) in w
     vec3<Real>* v;          ///< velocity (m/s)
     vec3<Real>* omega;      ///< angular velocity (rad/s)
+    vec3<Real>* v_sync;     ///< velocity at the time of the positions (m/s), seen by contact laws
+    vec3<Real>* omega_sync; ///< angular velocity at the time of the positions (rad/s)
     vec3<Real>* angpos;     ///< integrated angular position (rad)
     vec3<Real>* force;      ///< sum of contact forces of the last step (N), without gravity
     vec3<Real>* torque;     ///< sum of contact torques of the last step (N m)
@@ -37,7 +39,7 @@ struct particle_view {
 template <class Real>
 struct particle_snapshot {
     std::vector<vec4<Real>> x;
-    std::vector<vec3<Real>> v, omega, angpos, force, torque;
+    std::vector<vec3<Real>> v, omega, v_sync, omega_sync, angpos, force, torque;
     std::vector<Real> mass, pressure, e_visc, e_fric, p_visc, p_fric;
     std::vector<std::uint8_t> kind;
 
@@ -79,6 +81,8 @@ public:
             s.mass[i] = sphere_mass(p.radius, p.density);
             s.kind[i] = static_cast<std::uint8_t>(p.kind);
         }
+        s.v_sync = s.v;
+        s.omega_sync = s.omega;
         restore(s);
     }
 
@@ -86,14 +90,16 @@ public:
 
     particle_view<Real> view()
     {
-        return {x_.size(),       x_.data(),      v_.data(),      omega_.data(),  angpos_.data(),
+        return {x_.size(),       x_.data(),      v_.data(),      omega_.data(),  v_sync_.data(),
+                omega_sync_.data(),                                               angpos_.data(),
                 force_.data(),   torque_.data(), mass_.data(),   pressure_.data(), e_visc_.data(),
                 e_fric_.data(),  p_visc_.data(), p_fric_.data(), kind_.data()};
     }
 
     particle_snapshot<Real> snapshot() const
     {
-        return {x_.to_host(),      v_.to_host(),      omega_.to_host(),    angpos_.to_host(),
+        return {x_.to_host(),      v_.to_host(),      omega_.to_host(),    v_sync_.to_host(),
+                omega_sync_.to_host(),                                       angpos_.to_host(),
                 force_.to_host(),  torque_.to_host(), mass_.to_host(),     pressure_.to_host(),
                 e_visc_.to_host(), e_fric_.to_host(), p_visc_.to_host(),   p_fric_.to_host(),
                 kind_.to_host()};
@@ -105,6 +111,8 @@ public:
         x_.assign(s.x);
         v_.assign(s.v);
         omega_.assign(s.omega);
+        v_sync_.assign(s.v_sync);
+        omega_sync_.assign(s.omega_sync);
         angpos_.assign(s.angpos);
         force_.assign(s.force);
         torque_.assign(s.torque);
@@ -119,7 +127,7 @@ public:
 
 private:
     buffer<vec4<Real>, Policy> x_;
-    buffer<vec3<Real>, Policy> v_, omega_, angpos_, force_, torque_;
+    buffer<vec3<Real>, Policy> v_, omega_, v_sync_, omega_sync_, angpos_, force_, torque_;
     buffer<Real, Policy> mass_, pressure_, e_visc_, e_fric_, p_visc_, p_fric_;
     buffer<std::uint8_t, Policy> kind_;
 };
