@@ -10,9 +10,11 @@
 #include <vector>
 
 #include <thrust/sort.h>
+#include <thrust/system/cpp/execution_policy.h>
 #include <thrust/system/omp/execution_policy.h>
 
 #include "../core/config.cuh"
+#include "for_each.cuh"
 #include "policy.cuh"
 
 #if SPHERE_CUDA_COMPILER
@@ -40,7 +42,8 @@ struct min_op {
 template <class Key, class Value>
 void sort_by_key(host, Key* keys, Value* values, std::size_t n)
 {
-    thrust::stable_sort_by_key(thrust::omp::par, keys, keys + n, values);
+    if (n >= host_parallel_threshold) thrust::stable_sort_by_key(thrust::omp::par, keys, keys + n, values);
+    else thrust::stable_sort_by_key(thrust::cpp::par, keys, keys + n, values);
 }
 
 /// Returns init op f(0) op f(1) ... op f(n-1), in a fixed association order.
@@ -51,7 +54,7 @@ T transform_reduce(host, std::size_t n, const Transform& f, T init, Op op)
     const std::size_t chunks = (n + chunk - 1) / chunk;
     std::vector<T> partial(chunks, init);
     const long long count = static_cast<long long>(chunks);
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (chunks > 1)
     for (long long c = 0; c < count; ++c) {
         const std::size_t begin = static_cast<std::size_t>(c) * chunk;
         const std::size_t end = begin + chunk < n ? begin + chunk : n;

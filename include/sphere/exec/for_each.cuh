@@ -14,11 +14,15 @@
 
 namespace sphere {
 
+/// Below this many indices a host loop runs on the calling thread: starting a team of
+/// threads costs more than the work (and much more when the cores are busy).
+inline constexpr std::size_t host_parallel_threshold = 2048;
+
 template <class Body>
 void for_each_index(host, std::size_t n, const Body& body)
 {
     const long long count = static_cast<long long>(n);
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (n >= host_parallel_threshold)
     for (long long i = 0; i < count; ++i) body(static_cast<std::size_t>(i));
 }
 
