@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <fstream>
 #include <iostream>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -23,6 +24,26 @@ struct options {
     bool tension = false;
     std::string precision = "double", backend = "host", csv = "collision.csv";
 };
+
+/// Writes `text` to `path` through a temporary file and a rename, so that an interrupted run
+/// never leaves a half-written file behind.
+void write_file_atomically(const std::string& path, const std::string& text)
+{
+    const std::string tmp = path + ".tmp";
+    {
+        std::ofstream out(tmp, std::ios::binary);
+        out << text;
+        out.flush();
+        if (!out) {
+            std::remove(tmp.c_str());
+            throw sphere::error("cannot write the CSV output '" + path + "' (through '" + tmp + "')");
+        }
+    }
+    if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+        std::remove(tmp.c_str());
+        throw sphere::error("cannot rename '" + tmp + "' to the CSV output '" + path + "'");
+    }
+}
 
 template <class Real, class Policy>
 int run(const options& o)
@@ -62,8 +83,7 @@ int run(const options& o)
 
     simulation<Real, Policy> sim(s, p);
     const energy_budget<Real> e0 = sim.energy();
-    std::ofstream csv(o.csv);
-    if (!csv) throw error("cannot open the CSV output '" + o.csv + "' for writing");
+    std::ostringstream csv; // written to the file only once the run has succeeded
     csv << "time_s,x1_m,z1_m,vx1_m_s,vz1_m_s,omegay1_rad_s,x2_m,z2_m,vx2_m_s,vz2_m_s,overlap_m,normal_force_N,"
            "kinetic_J,rotational_J,elastic_J,dissipated_visc_J,dissipated_fric_J,total_J\n";
     csv.precision(10);
@@ -119,6 +139,7 @@ int run(const options& o)
                 double(e1.dissipated_visc), double(e1.dissipated_fric));
     std::printf("%-28s %14.6e %14s %10.2e\n", "energy balance error (J)", before - after - dissipated, "0",
                 std::fabs(before - after - dissipated) / before);
+    write_file_atomically(o.csv, csv.str());
     std::printf("time series written to %s\n", o.csv.c_str());
     return 0;
 }

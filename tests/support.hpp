@@ -1,0 +1,74 @@
+#pragma once
+// Shared set-up for the validation tests: the common parameter set "P" of
+// ../shared/VALIDATION.md and small helpers. Every test is a TEMPLATE_TEST_CASE over float
+// and double; tolerances are stated where each test asserts.
+#include <sphere/dem.cuh>
+
+#include <cmath>
+#include <vector>
+
+namespace sphere_test {
+
+/// Set P: R = 0.01 m, rho = 2500 kg/m^3, k_n = 1e5 N/m, no gravity.
+template <class Real>
+struct set_p {
+    static constexpr Real radius = Real(0.01);
+    static constexpr Real density = Real(2500);
+    static constexpr Real k_n = Real(1e5);
+    static Real mass() { return sphere::sphere_mass(radius, density); } // 1.047198e-2 kg
+    static Real inertia() { return Real(0.4) * mass() * radius * radius; }
+    static Real dt() { return Real(0.075) * std::sqrt(mass() / k_n); } // 2.42703e-5 s
+};
+
+/// Settings for a closed box [-half, half]^3 with set-P stiffness and frictionless, undamped
+/// contacts; tests switch on what they need.
+template <class Real>
+sphere::settings<Real> box_settings(Real half = Real(0.1))
+{
+    sphere::settings<Real> s;
+    s.box.lo = {-half, -half, -half};
+    s.box.hi = {half, half, half};
+    s.contact.k_n = set_p<Real>::k_n;
+    s.contact.k_t = set_p<Real>::k_n * Real(2) / Real(7);
+    s.wall = s.contact;
+    return s;
+}
+
+template <class Real>
+sphere::particle<Real> ball(sphere::vec3<Real> position, sphere::vec3<Real> velocity = {0, 0, 0},
+                            Real radius = set_p<Real>::radius)
+{
+    sphere::particle<Real> p;
+    p.position = position;
+    p.radius = radius;
+    p.density = set_p<Real>::density;
+    p.velocity = velocity;
+    return p;
+}
+
+/// |a - b| / |b|
+template <class Real>
+double rel_err(Real a, double b)
+{
+    return std::abs(static_cast<double>(a) - b) / std::abs(b);
+}
+
+/// Steps until no particle touches another or a wall (all contact lists hold no overlap),
+/// at most max_steps; returns the number of steps taken.
+template <class Sim>
+std::size_t run_until_separated(Sim& sim, std::size_t max_steps)
+{
+    std::size_t k = 0;
+    bool touched = false;
+    for (; k < max_steps; ++k) {
+        sim.step();
+        const auto s = sim.snapshot();
+        double fn = 0;
+        for (std::size_t i = 0; i < s.size(); ++i) fn += static_cast<double>(s.pressure[i]);
+        if (fn > 0) touched = true;
+        else if (touched) break;
+    }
+    return k;
+}
+
+} // namespace sphere_test
