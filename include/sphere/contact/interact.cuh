@@ -3,6 +3,9 @@
 /// The interaction kernel: each particle gathers the forces and torques of its listed
 /// partners and of the walls it touches, with no atomics, so results are deterministic.
 /// Each pair is evaluated from both sides; each side books half of the pair's dissipation.
+/// Dashpots see the velocities at the time of the positions (v_sync, omega_sync); tangential
+/// springs follow the displacement of the last step (v, omega times dt: the velocities that
+/// moved the positions).
 #include <cstddef>
 
 #include "../boundary/walls.cuh"
@@ -45,8 +48,10 @@ struct interact {
             if (delta_n < Real(0) && dist > Real(0)) {
                 const vec3<Real> n = d / dist;
                 const Real arm_i = xi.w + delta_n / 2, arm_j = xj.w + delta_n / 2;
-                const vec3<Real> vc = vi - p.v_sync[j] + arm_i * cross(n, wi) + arm_j * cross(n, p.omega_sync[j]);
-                const contact_result<Real> r = Law::pair(pair_params, n, delta_n, vc, h, dt);
+                const contact_motion<Real> m{
+                    n, delta_n, vi - p.v_sync[j] + arm_i * cross(n, wi) + arm_j * cross(n, p.omega_sync[j]),
+                    (p.v[i] - p.v[j] + arm_i * cross(n, p.omega[i]) + arm_j * cross(n, p.omega[j])) * dt};
+                const contact_result<Real> r = Law::pair(pair_params, m, h, dt);
                 force += r.normal + r.tangential;
                 torque -= arm_i * cross(n, r.tangential);
                 fn_sum += r.fn;
@@ -68,9 +73,10 @@ struct interact {
             const Real delta_n = dist - xi.w;
             vec4<Real> h = c.wall_history[e];
             if (delta_n < Real(0)) {
-                vec3<Real> vc = vi + dist * cross(n, wi);
-                vc[a] -= wall.velocity;
-                const contact_result<Real> r = Law::wall(wall_params, n, delta_n, vc, h, dt);
+                contact_motion<Real> m{n, delta_n, vi + dist * cross(n, wi), (p.v[i] + dist * cross(n, p.omega[i])) * dt};
+                m.velocity[a] -= wall.velocity;
+                m.step[a] -= wall.velocity * dt;
+                const contact_result<Real> r = Law::wall(wall_params, m, h, dt);
                 force += r.normal + r.tangential;
                 torque -= dist * cross(n, r.tangential);
                 fn_sum += r.fn;

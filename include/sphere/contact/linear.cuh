@@ -55,22 +55,20 @@ struct linear {
         WallTangential::validate(wall, "settings.wall");
     }
 
-    /// Evaluates a pair contact: delta_n < 0 the overlap (m), n the unit normal towards this
-    /// particle, vc the velocity of this particle's contact point relative to the partner's
-    /// (m/s), h the contact's history entry, dt the time step (s).
+    /// Evaluates a pair contact with motion m, history entry h and time step dt (s).
     template <class Real>
-    SPHERE_HD static contact_result<Real> pair(const contact_params<Real>& p, const vec3<Real>& n, Real delta_n,
-                                               const vec3<Real>& vc, vec4<Real>& h, Real dt)
+    SPHERE_HD static contact_result<Real> pair(const contact_params<Real>& p, const contact_motion<Real>& m,
+                                               vec4<Real>& h, Real dt)
     {
-        return evaluate<PairTangential>(p, n, delta_n, vc, h, dt);
+        return evaluate<PairTangential>(p, m, h, dt);
     }
 
-    /// Evaluates a wall contact, with the same meaning of the arguments (the wall is the partner).
+    /// Evaluates a wall contact (the wall is the partner).
     template <class Real>
-    SPHERE_HD static contact_result<Real> wall(const contact_params<Real>& p, const vec3<Real>& n, Real delta_n,
-                                               const vec3<Real>& vc, vec4<Real>& h, Real dt)
+    SPHERE_HD static contact_result<Real> wall(const contact_params<Real>& p, const contact_motion<Real>& m,
+                                               vec4<Real>& h, Real dt)
     {
-        return evaluate<WallTangential>(p, n, delta_n, vc, h, dt);
+        return evaluate<WallTangential>(p, m, h, dt);
     }
 
     /// Elastic energy stored in a pair contact: k_n delta_n^2 / 2 plus the tangential spring (J).
@@ -89,14 +87,16 @@ struct linear {
 
 private:
     template <class Tangential, class Real>
-    SPHERE_HD static contact_result<Real> evaluate(const contact_params<Real>& p, const vec3<Real>& n, Real delta_n,
-                                                   const vec3<Real>& vc, vec4<Real>& h, Real dt)
+    SPHERE_HD static contact_result<Real> evaluate(const contact_params<Real>& p, const contact_motion<Real>& m,
+                                                   vec4<Real>& h, Real dt)
     {
-        const Real ddelta_n = dot(vc, n);
-        const normal_force<Real> fn = linear_normal(p, delta_n, ddelta_n);
-        const vec3<Real> vt = vc - n * ddelta_n;
+        const vec3<Real>& n = m.n;
+        const Real ddelta_n = dot(m.velocity, n);
+        const normal_force<Real> fn = linear_normal(p, m.delta_n, ddelta_n);
+        const vec3<Real> vt = m.velocity - n * ddelta_n;
+        const vec3<Real> step_t = m.step - n * dot(m.step, n);
         const Real fn_abs = fn.magnitude < Real(0) ? -fn.magnitude : fn.magnitude; // < 0 only with tension
-        const tangential_force<Real> ft = Tangential::evaluate(p, n, vt, fn_abs, h, dt);
+        const tangential_force<Real> ft = Tangential::evaluate(p, n, vt, step_t, fn_abs, h, dt);
         contact_result<Real> out;
         out.normal = n * fn.magnitude;
         out.tangential = ft.force;

@@ -1,9 +1,20 @@
 #pragma once
 /// \file
-/// What a contact law returns for one contact.
+/// What a contact law is given for one contact, and what it returns.
 #include "../core/vec.cuh"
 
 namespace sphere {
+
+/// The geometry and relative motion of one contact, as seen by the particle it acts on.
+template <class Real>
+struct contact_motion {
+    vec3<Real> n;        ///< unit normal, from the partner (particle or wall) towards this particle
+    Real delta_n;        ///< overlap (m), negative while in contact
+    vec3<Real> velocity; ///< velocity of this particle's contact point relative to the partner's,
+                         ///< at the time of the positions (m/s): drives the dashpots
+    vec3<Real> step;     ///< displacement of the contact point relative to the partner's during
+                         ///< the step that led to the positions (m): drives the tangential spring
+};
 
 /// One evaluated contact, as seen by the particle it acts on.
 template <class Real>

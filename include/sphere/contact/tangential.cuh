@@ -1,7 +1,9 @@
 #pragma once
 /// \file
-/// Tangential contact laws (policy types). Each takes the contact's history entry
-/// h = (delta_t.x, delta_t.y, delta_t.z, sliding flag) and returns the tangential force on
+/// Tangential contact laws (policy types). Each takes the unit normal n, the tangential
+/// contact velocity v_t (m/s) at the time of the positions, the tangential displacement of the
+/// contact point during the last step (m), |f_n| (N) and the contact's history entry
+/// h = (delta_t.x, delta_t.y, delta_t.z, sliding flag), and returns the tangential force on
 /// this particle with its dissipation rates. Equations: docs/physics.md, "Tangential force".
 #include <cmath>
 
@@ -29,7 +31,8 @@ struct visco_frictional {
 
     template <class Real>
     SPHERE_HD static tangential_force<Real> evaluate(const contact_params<Real>& p, const vec3<Real>& /*n*/,
-                                                     const vec3<Real>& vt, Real fn, vec4<Real>& h, Real /*dt*/)
+                                                     const vec3<Real>& vt, const vec3<Real>& /*step_t*/, Real fn,
+                                                     vec4<Real>& h, Real /*dt*/)
     {
         tangential_force<Real> out;
         out.force = -p.gamma_t * vt;
@@ -52,8 +55,9 @@ struct visco_frictional {
     SPHERE_HD static Real stored_energy(const contact_params<Real>&, const vec4<Real>&) { return 0; }
 };
 
-/// f_t = -k_t delta_t - gamma_t v_t with the incremental tangential displacement delta_t,
-/// kept in the current contact plane (projected and rescaled to its length, so a rigid
+/// f_t = -k_t delta_t - gamma_t v_t with the incremental tangential displacement delta_t
+/// (incremented by the contact point's tangential displacement in each step), kept in the
+/// current contact plane (projected and rescaled to its length, so a rigid
 /// rotation of the pair rotates it without shrinking it). At the Coulomb limit the
 /// displacement is rescaled so that f_t = mu_d |f_n| t_hat:
 /// delta_t = -(mu_d |f_n| t_hat + gamma_t v_t) / k_t (VALIDATION pitfall 4: note the sign).
@@ -67,7 +71,8 @@ struct elastic_viscous_frictional {
 
     template <class Real>
     SPHERE_HD static tangential_force<Real> evaluate(const contact_params<Real>& p, const vec3<Real>& n,
-                                                     const vec3<Real>& vt, Real fn, vec4<Real>& h, Real dt)
+                                                     const vec3<Real>& vt, const vec3<Real>& step_t, Real fn,
+                                                     vec4<Real>& h, Real dt)
     {
         tangential_force<Real> out;
         // Carry the displacement into the current contact plane, keeping its length.
@@ -76,7 +81,7 @@ struct elastic_viscous_frictional {
         d -= n * dot(n, d);
         const Real len_in_plane = norm(d);
         d = len_in_plane > Real(0) ? d * (len / len_in_plane) : vec3<Real>{0, 0, 0};
-        d += vt * dt;
+        d += step_t; // the spring follows the contact point's actual motion
 
         out.force = -p.k_t * d - p.gamma_t * vt;
         const Real ft = norm(out.force);
