@@ -105,6 +105,7 @@ public:
         }
 
         particles_ = particle_state<Real, Policy>(particles);
+        for (const particle<Real>& p : particles) kinds_.push_back(p.kind);
         walls_ = wall_set<Real>::from_world(s.box);
         grid_ = neighbor_grid<Real, Policy>(grid_geometry<Real>::make(s.box, 2 * max_radius + s.skin, s.cell_size));
         lists_ = contact_lists<Real, Policy>(particles.size(), s.contact_capacity);
@@ -147,10 +148,15 @@ public:
     }
 
     /// Sets the velocity (m/s) and angular velocity (rad/s) of particle i; a prescribed
-    /// particle keeps them until set again.
+    /// particle keeps them until set again. Throws for a fixed particle or non-finite values.
     void set_velocity(std::size_t i, const vec3<Real>& v, const vec3<Real>& omega)
     {
         if (i >= size()) detail::fail("set_velocity: particle index ", i, " out of range (", size(), " particles)");
+        if (kinds_[i] == motion::fixed)
+            detail::fail("set_velocity: particle ", i, " is fixed and cannot move; give it motion::prescribed instead");
+        if (!isfinite(v) || !isfinite(omega))
+            detail::fail("set_velocity: particle ", i, ": velocity (", v.x, ", ", v.y, ", ", v.z,
+                         ") m/s or angular velocity (", omega.x, ", ", omega.y, ", ", omega.z, ") rad/s is not finite");
         for_each_index(Policy{}, 1, detail::set_kinematics<Real>{particles_.view(), i, v, omega});
     }
 
@@ -193,7 +199,7 @@ private:
     {
         particle_view<Real> p = particles_.view();
         grid_.build(p);
-        const std::size_t overflow = lists_.rebuild(grid_.view(), p.x, settings_.skin);
+        const std::size_t overflow = lists_.rebuild(grid_.view(), settings_.skin);
         ++rebuilds_;
         if (overflow != ~std::size_t(0))
             detail::fail("step ", steps_, ": particle ", overflow, " has ", lists_.count_of(overflow),
@@ -225,6 +231,7 @@ private:
     neighbor_grid<Real, Policy> grid_;
     contact_lists<Real, Policy> lists_;
     buffer<vec4<Real>, Policy> x_at_build_;
+    std::vector<motion> kinds_; ///< host copy of each particle's motion (it never changes)
     std::vector<std::pair<std::size_t, observer>> observers_;
 };
 

@@ -32,13 +32,13 @@ struct world {
         return d;
     }
 
-    /// Maps a coordinate on a periodic axis back into [lo, hi); unchanged on wall axes.
+    /// Maps a coordinate on a periodic axis into [lo, hi), however many periods away it is;
+    /// unchanged on wall axes.
     SPHERE_HD Real wrap(Real c, int a) const
     {
-        if (!periodic(a)) return c;
-        if (c >= hi[a]) c -= length(a);
-        else if (c < lo[a]) c += length(a);
-        return c;
+        if (!periodic(a) || !std::isfinite(c) || (c >= lo[a] && c < hi[a])) return c;
+        c -= length(a) * std::floor((c - lo[a]) / length(a));
+        return c >= lo[a] && c < hi[a] ? c : lo[a]; // round-off can land on hi or a hair below lo
     }
 };
 

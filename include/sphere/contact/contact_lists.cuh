@@ -30,12 +30,11 @@ struct contact_view {
 };
 
 namespace detail {
-/// Builds particle i's new partner list from the grid and carries over the history of
-/// partners that were already listed.
+/// Builds the new partner list of the particle at sorted position k (neighbouring threads
+/// then read neighbouring cells) and carries over the history of partners already listed.
 template <class Real>
 struct build_contact_list {
     grid_view<Real> grid;
-    const vec4<Real>* x;
     Real skin;
     std::size_t capacity;
     const unsigned* old_count;
@@ -45,40 +44,33 @@ struct build_contact_list {
     unsigned* partner;
     vec4<Real>* history;
 
-    SPHERE_HD void operator()(std::size_t i) const
+    SPHERE_HD void operator()(std::size_t k) const
     {
         const grid_geometry<Real>& g = grid.geometry;
-        const vec4<Real> xi = x[i];
+        const std::size_t i = grid.order[k];
+        const vec4<Real> xi = grid.sorted_x[k];
         const int ci[3] = {g.coordinate(xi.x, 0), g.coordinate(xi.y, 1), g.coordinate(xi.z, 2)};
+        const int nx = static_cast<int>(g.n[0]);
         unsigned* mine = partner + i * capacity;
         unsigned found = 0;
         for (int dz = -1; dz <= 1; ++dz)
-            for (int dy = -1; dy <= 1; ++dy)
-                for (int dx = -1; dx <= 1; ++dx) {
-                    const int d[3] = {dx, dy, dz};
-                    int c[3];
-                    bool inside = true;
-                    for (int a = 0; a < 3; ++a) {
-                        c[a] = ci[a] + d[a];
-                        const int na = static_cast<int>(g.n[a]);
-                        if (g.box.periodic(a)) c[a] = (c[a] + na) % na;
-                        else if (c[a] < 0 || c[a] >= na) inside = false;
-                    }
-                    if (!inside) continue;
-                    const unsigned cell = g.index(c[0], c[1], c[2]);
-                    const unsigned start = grid.cell_start[cell];
-                    if (start == grid_view<Real>::empty_cell) continue;
-                    for (unsigned k = start; k < grid.cell_end[cell]; ++k) {
-                        const unsigned j = grid.order[k];
-                        if (j == i) continue;
-                        const vec4<Real> xj = grid.sorted_x[k];
-                        const Real reach = xi.w + xj.w + skin;
-                        if (norm2(g.box.nearest_image(xi.xyz() - xj.xyz())) < reach * reach) {
-                            if (found < capacity) mine[found] = j;
-                            ++found;
-                        }
-                    }
+            for (int dy = -1; dy <= 1; ++dy) {
+                int cy = ci[1] + dy, cz = ci[2] + dz;
+                if (!wrap_or_reject(cy, 1) || !wrap_or_reject(cz, 2)) continue;
+                // The row's cells ci[0]-1 .. ci[0]+1 along x: one run of sorted positions, or two
+                // when a periodic x wraps around.
+                int x0 = ci[0] - 1, x1 = ci[0] + 1;
+                int wrapped0 = 0, wrapped1 = -1;
+                if (g.box.periodic(0)) {
+                    if (x0 < 0) { wrapped0 = wrapped1 = nx - 1; x0 = 0; }
+                    if (x1 >= nx) { wrapped0 = wrapped1 = 0; x1 = nx - 1; }
+                } else {
+                    x0 = x0 < 0 ? 0 : x0;
+                    x1 = x1 >= nx ? nx - 1 : x1;
                 }
+                found = scan_run(i, xi, g.index(x0, cy, cz), g.index(x1, cy, cz), mine, found);
+                if (wrapped1 >= 0) found = scan_run(i, xi, g.index(wrapped0, cy, cz), g.index(wrapped1, cy, cz), mine, found);
+            }
         count[i] = found;
         const unsigned kept = found < capacity ? found : static_cast<unsigned>(capacity);
         for (unsigned a = 1; a < kept; ++a) { // insertion sort by partner index: lists are short
@@ -95,6 +87,37 @@ struct build_contact_list {
             history[i * capacity + a] =
                 (m < old_kept && before[m] == mine[a]) ? old_history[i * capacity + m] : vec4<Real>{0, 0, 0, 0};
         }
+    }
+
+private:
+    /// Wraps cell coordinate c on a periodic axis; false when it lies outside a wall axis.
+    SPHERE_HD bool wrap_or_reject(int& c, int a) const
+    {
+        const int n = static_cast<int>(grid.geometry.n[a]);
+        if (grid.geometry.box.periodic(a)) {
+            c = (c + n) % n;
+            return true;
+        }
+        return c >= 0 && c < n;
+    }
+
+    /// Lists every particle of cells [first_cell, last_cell] within reach of particle i;
+    /// returns the updated number found (entries beyond the capacity are counted, not stored).
+    SPHERE_HD unsigned scan_run(std::size_t i, const vec4<Real>& xi, unsigned first_cell, unsigned last_cell,
+                                unsigned* mine, unsigned found) const
+    {
+        const unsigned end = grid.cell_start[last_cell + 1];
+        for (unsigned k = grid.cell_start[first_cell]; k < end; ++k) {
+            const unsigned j = grid.order[k];
+            if (j == i) continue;
+            const vec4<Real> xj = grid.sorted_x[k];
+            const Real reach = xi.w + xj.w + skin;
+            if (norm2(grid.geometry.box.nearest_image(xi.xyz() - xj.xyz())) < reach * reach) {
+                if (found < capacity) mine[found] = j;
+                ++found;
+            }
+        }
+        return found;
     }
 };
 
@@ -121,11 +144,11 @@ public:
 
     /// Rebuilds every list from a built grid; returns the first particle whose partners
     /// exceed the capacity, or ~0 when none does.
-    std::size_t rebuild(const grid_view<Real>& grid, const vec4<Real>* x, Real skin)
+    std::size_t rebuild(const grid_view<Real>& grid, Real skin)
     {
         const std::size_t n = count_.size();
         for_each_index(Policy{}, n,
-                       detail::build_contact_list<Real>{grid, x, skin, capacity_, count_.data(), partner_.data(),
+                       detail::build_contact_list<Real>{grid, skin, capacity_, count_.data(), partner_.data(),
                                                         history_.data(), new_count_.data(), new_partner_.data(),
                                                         new_history_.data()});
         count_.swap(new_count_);

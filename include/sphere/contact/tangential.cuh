@@ -61,6 +61,9 @@ struct visco_frictional {
 /// rotation of the pair rotates it without shrinking it). At the Coulomb limit the
 /// displacement is rescaled so that f_t = mu_d |f_n| t_hat:
 /// delta_t = -(mu_d |f_n| t_hat + gamma_t v_t) / k_t (VALIDATION pitfall 4: note the sign).
+/// Sticking, the dashpot dissipates gamma_t |v_t|^2; sliding, the contact dissipates the power
+/// -f_t . v_t it takes from the motion less the change of the spring's energy, so the energy
+/// budget closes whatever gamma_t is.
 struct elastic_viscous_frictional {
     template <class Real>
     static void validate(const contact_params<Real>& p, const char* where)
@@ -80,8 +83,8 @@ struct elastic_viscous_frictional {
         const Real len = norm(d);
         d -= n * dot(n, d);
         const Real len_in_plane = norm(d);
-        d = len_in_plane > Real(0) ? d * (len / len_in_plane) : vec3<Real>{0, 0, 0};
-        d += step_t; // the spring follows the contact point's actual motion
+        const vec3<Real> before = len_in_plane > Real(0) ? d * (len / len_in_plane) : vec3<Real>{0, 0, 0};
+        d = before + step_t; // the spring follows the contact point's actual motion
 
         out.force = -p.k_t * d - p.gamma_t * vt;
         const Real ft = norm(out.force);
@@ -90,9 +93,10 @@ struct elastic_viscous_frictional {
         if (ft > limit) {
             const Real slide_limit = p.mu_d * fn;
             const vec3<Real> t_hat = out.force / ft;
-            const vec3<Real> slid = -(slide_limit * t_hat + p.gamma_t * vt) / p.k_t;
-            out.fric_rate = slide_limit * norm(d - slid) / dt;
+            const vec3<Real> slid = -(slide_limit / p.k_t) * t_hat;
             out.force = slide_limit * t_hat;
+            // Sliding: the power taken from the motion, -f_t . v_t, less what the spring stored.
+            out.fric_rate = -dot(out.force, vt) - Real(0.5) * p.k_t * (norm2(slid) - norm2(before)) / dt;
             d = slid;
             h.w = 1;
         } else {

@@ -1,7 +1,7 @@
 #pragma once
 /// \file
 /// The uniform neighbour grid: hash each particle to its cell, sort by cell (stable),
-/// gather positions in cell order and find each cell's [start, end) in the sorted order.
+/// gather positions in cell order and find where each cell starts in the sorted order.
 #include <cstddef>
 
 #include "../core/vec.cuh"
@@ -13,15 +13,15 @@
 
 namespace sphere {
 
-/// Kernel view of a built grid.
+/// Kernel view of a built grid. The particles of cells [a, b] (consecutive along x) sit at
+/// sorted positions [cell_start[a], cell_start[b + 1]).
 template <class Real>
 struct grid_view {
     grid_geometry<Real> geometry;
+    std::size_t n;               ///< number of particles
     const unsigned* order;       ///< particle index at each sorted position
     const vec4<Real>* sorted_x;  ///< position and radius at each sorted position
-    const unsigned* cell_start;  ///< first sorted position of each cell (empty_cell if none)
-    const unsigned* cell_end;    ///< one past the last sorted position of each cell
-    static constexpr unsigned empty_cell = 0xffffffffu;
+    const unsigned* cell_start;  ///< first sorted position of each cell; cell_count() + 1 entries
 };
 
 namespace detail {
@@ -38,26 +38,24 @@ struct hash_particles {
     }
 };
 
-struct fill_empty {
-    unsigned* cell_start;
-    SPHERE_HD void operator()(std::size_t c) const { cell_start[c] = 0xffffffffu; }
-};
-
+/// Sorted position k sets cell_start for every cell from its predecessor's key (exclusive)
+/// up to its own key (inclusive), so empty cells start where the next particle does; the
+/// sorted position one past the end closes the array. Each cell is written exactly once.
 template <class Real>
-struct find_cell_bounds {
+struct find_cell_starts {
     std::size_t n;
+    std::size_t cells;
     const unsigned* key;
     const unsigned* order;
     const vec4<Real>* x;
     vec4<Real>* sorted_x;
     unsigned* cell_start;
-    unsigned* cell_end;
     SPHERE_HD void operator()(std::size_t k) const
     {
-        const unsigned c = key[k];
-        if (k == 0 || key[k - 1] != c) cell_start[c] = static_cast<unsigned>(k);
-        if (k + 1 == n || key[k + 1] != c) cell_end[c] = static_cast<unsigned>(k + 1);
-        sorted_x[k] = x[order[k]];
+        const std::size_t first = k == 0 ? 0 : std::size_t(key[k - 1]) + 1;
+        const std::size_t last = k == n ? cells : std::size_t(key[k]);
+        for (std::size_t c = first; c <= last; ++c) cell_start[c] = static_cast<unsigned>(k);
+        if (k < n) sorted_x[k] = x[order[k]];
     }
 };
 } // namespace detail
@@ -78,26 +76,22 @@ public:
             order_.resize(p.n);
             sorted_x_.resize(p.n);
         }
-        if (cell_start_.size() != cells) {
-            cell_start_.resize(cells);
-            cell_end_.resize(cells);
-        }
+        if (cell_start_.size() != cells + 1) cell_start_.resize(cells + 1);
         for_each_index(Policy{}, p.n, detail::hash_particles<Real>{geometry_, p.x, key_.data(), order_.data()});
         sort_by_key(Policy{}, key_.data(), order_.data(), p.n);
-        for_each_index(Policy{}, cells, detail::fill_empty{cell_start_.data()});
-        for_each_index(Policy{}, p.n,
-                       detail::find_cell_bounds<Real>{p.n, key_.data(), order_.data(), p.x, sorted_x_.data(),
-                                                      cell_start_.data(), cell_end_.data()});
+        for_each_index(Policy{}, p.n + 1,
+                       detail::find_cell_starts<Real>{p.n, cells, key_.data(), order_.data(), p.x, sorted_x_.data(),
+                                                      cell_start_.data()});
     }
 
     grid_view<Real> view() const
     {
-        return {geometry_, order_.data(), sorted_x_.data(), cell_start_.data(), cell_end_.data()};
+        return {geometry_, key_.size(), order_.data(), sorted_x_.data(), cell_start_.data()};
     }
 
 private:
     grid_geometry<Real> geometry_;
-    buffer<unsigned, Policy> key_, order_, cell_start_, cell_end_;
+    buffer<unsigned, Policy> key_, order_, cell_start_;
     buffer<vec4<Real>, Policy> sorted_x_;
 };
 

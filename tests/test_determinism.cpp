@@ -1,0 +1,264 @@
+// Determinism of the host backend: the same input gives bit-identical particle states, run
+// after run and for 1 or 2 OpenMP threads (each particle gathers its own forces without
+// atomics, the neighbour sort is stable, and reductions sum fixed chunks in a fixed order;
+// include/sphere/exec/algorithms.cuh). Every field of snapshot() is compared bytewise
+// (memcmp), and so are the contact lists with their histories and the energy budget.
+#include <catch2/catch.hpp>
+
+#include "support.hpp"
+
+#include <omp.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
+#include <random>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace {
+
+using sphere::vec3;
+
+/// Restores the OpenMP thread count when a test leaves (also on failure).
+struct thread_count_guard {
+    int saved = omp_get_max_threads();
+    ~thread_count_guard() { omp_set_num_threads(saved); }
+};
+
+/// Number of threads an OpenMP parallel region really gets after omp_set_num_threads(n).
+int threads_in_parallel_region()
+{
+    int seen = 0;
+#pragma omp parallel
+    {
+#pragma omp single
+        seen = omp_get_num_threads();
+    }
+    return seen;
+}
+
+/// per_axis^3 polydisperse particles (radii uniform in [0.5, 1.5] x 1 cm) on a jittered lattice
+/// with gaps of 0.02-2 cm, random velocities N(0, 1 m/s) and spins N(0, 100 rad/s), in a
+/// closed box: they collide with each other and the walls within the first few hundred
+/// steps. Friction (mu_s 0.5, mu_d 0.4), damping (gamma_n, gamma_t) on pairs and walls,
+/// gravity. One particle in 50 is prescribed (keeps its velocity) and one in 50 is fixed.
+template <class Real>
+std::pair<sphere::settings<Real>, std::vector<sphere::particle<Real>>> assembly(int per_axis, Real skin,
+                                                                               std::uint32_t seed)
+{
+    const double r0 = 0.01, spacing = 3.04 * r0;
+    const double half = per_axis * spacing / 2;
+    sphere::settings<Real> s;
+    s.box.lo = {Real(-half), Real(-half), Real(-half)};
+    s.box.hi = {Real(half), Real(half), Real(half)};
+    s.contact.k_n = Real(1e5);
+    s.contact.k_t = Real(1e5 * 2.0 / 7.0);
+    s.contact.gamma_n = Real(5);
+    s.contact.gamma_t = Real(2);
+    s.contact.mu_s = Real(0.5);
+    s.contact.mu_d = Real(0.4);
+    s.wall = s.contact;
+    s.wall.gamma_t = Real(20);
+    s.wall.mu_s = Real(0.3);
+    s.wall.mu_d = Real(0.3);
+    s.gravity = {Real(0), Real(0), Real(-9.81)};
+    s.skin = skin;
+
+    std::mt19937 gen(seed);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    std::normal_distribution<double> normal(0.0, 1.0);
+    std::vector<sphere::particle<Real>> ps;
+    for (int k = 0; k < per_axis; ++k)
+        for (int j = 0; j < per_axis; ++j)
+            for (int i = 0; i < per_axis; ++i) {
+                sphere::particle<Real> p;
+                p.radius = Real(r0 * (0.5 + unit(gen)));
+                p.density = Real(2500);
+                p.position = {Real(-half + (i + 0.5) * spacing + 0.02 * r0 * (unit(gen) - 0.5)),
+                              Real(-half + (j + 0.5) * spacing + 0.02 * r0 * (unit(gen) - 0.5)),
+                              Real(-half + (k + 0.5) * spacing + 0.02 * r0 * (unit(gen) - 0.5))};
+                for (int a = 0; a < 3; ++a) {
+                    p.velocity[a] = Real(normal(gen));
+                    p.angular_velocity[a] = Real(100 * normal(gen));
+                }
+                const std::size_t index = ps.size();
+                if (index % 50 == 7) p.kind = sphere::motion::prescribed;
+                if (index % 50 == 23) p.kind = sphere::motion::fixed;
+                ps.push_back(p);
+            }
+    return {s, ps};
+}
+
+template <class T>
+bool same_bytes(const std::vector<T>& a, const std::vector<T>& b)
+{
+    return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
+}
+
+/// Everything a simulation reports, recorded right after a run (so that the diagnostics,
+/// which are reductions, run under the same thread count as the run).
+template <class Real>
+struct record {
+    sphere::particle_snapshot<Real> snap;
+    std::vector<unsigned> counts, partners;
+    std::vector<sphere::vec4<Real>> histories, wall_histories;
+    sphere::energy_budget<Real> energy;
+    vec3<Real> momentum;
+    std::size_t rebuilds, steps;
+    double time;
+};
+
+template <class Sim>
+record<typename Sim::real_type> record_of(const Sim& sim)
+{
+    return {sim.snapshot(),
+            sim.contacts().counts(),
+            sim.contacts().partners(),
+            sim.contacts().histories(),
+            sim.contacts().wall_histories(),
+            sim.energy(),
+            sim.momentum(),
+            sim.rebuilds(),
+            sim.steps(),
+            sim.time()};
+}
+
+/// Names of the fields of two records that differ in any bit (empty: identical).
+template <class Real>
+std::vector<std::string> differences(const record<Real>& a, const record<Real>& b)
+{
+    std::vector<std::string> out;
+    const auto &sa = a.snap, &sb = b.snap;
+    if (!same_bytes(sa.x, sb.x)) out.push_back("x");
+    if (!same_bytes(sa.v, sb.v)) out.push_back("v");
+    if (!same_bytes(sa.omega, sb.omega)) out.push_back("omega");
+    if (!same_bytes(sa.v_sync, sb.v_sync)) out.push_back("v_sync");
+    if (!same_bytes(sa.omega_sync, sb.omega_sync)) out.push_back("omega_sync");
+    if (!same_bytes(sa.angpos, sb.angpos)) out.push_back("angpos");
+    if (!same_bytes(sa.force, sb.force)) out.push_back("force");
+    if (!same_bytes(sa.torque, sb.torque)) out.push_back("torque");
+    if (!same_bytes(sa.mass, sb.mass)) out.push_back("mass");
+    if (!same_bytes(sa.pressure, sb.pressure)) out.push_back("pressure");
+    if (!same_bytes(sa.e_visc, sb.e_visc)) out.push_back("e_visc");
+    if (!same_bytes(sa.e_fric, sb.e_fric)) out.push_back("e_fric");
+    if (!same_bytes(sa.p_visc, sb.p_visc)) out.push_back("p_visc");
+    if (!same_bytes(sa.p_fric, sb.p_fric)) out.push_back("p_fric");
+    if (!same_bytes(sa.kind, sb.kind)) out.push_back("kind");
+    if (!same_bytes(a.counts, b.counts)) out.push_back("contact counts");
+    if (!same_bytes(a.partners, b.partners)) out.push_back("contact partners");
+    if (!same_bytes(a.histories, b.histories)) out.push_back("contact histories");
+    if (!same_bytes(a.wall_histories, b.wall_histories)) out.push_back("wall histories");
+    if (std::memcmp(&a.energy, &b.energy, sizeof a.energy) != 0) out.push_back("energy budget");
+    if (std::memcmp(&a.momentum, &b.momentum, sizeof a.momentum) != 0) out.push_back("momentum");
+    if (a.rebuilds != b.rebuilds) out.push_back("rebuilds");
+    if (a.steps != b.steps || std::memcmp(&a.time, &b.time, sizeof a.time) != 0) out.push_back("steps or time");
+    return out;
+}
+
+/// The run did something worth comparing: contacts formed, friction slid, walls were hit.
+template <class Sim>
+void require_eventful(const Sim& sim)
+{
+    const auto e = sim.energy();
+    const auto snap = sim.snapshot();
+    std::size_t touching = 0;
+    for (std::size_t i = 0; i < snap.size(); ++i)
+        if (snap.pressure[i] > 0) ++touching;
+    INFO("dissipated: viscous " << e.dissipated_visc << " J, frictional " << e.dissipated_fric << " J; "
+                                << touching << " of " << snap.size() << " particles in contact; "
+                                << sim.rebuilds() << " rebuilds in " << sim.steps() << " steps");
+    REQUIRE(e.dissipated_visc > 0);
+    REQUIRE(e.dissipated_fric > 0);
+    REQUIRE(touching >= 10);
+}
+
+} // namespace
+
+TEMPLATE_TEST_CASE("two runs of the same input give bit-identical states", "[determinism]", float, double)
+{
+    using Real = TestType;
+    const std::size_t steps = 300;
+    Real skin = 0;
+    SECTION("skin 0") { skin = 0; }
+    SECTION("skin 0.2 r0") { skin = Real(0.002); }
+    const auto setup = assembly<Real>(7, skin, 99); // 343 particles
+
+    sphere::simulation<Real> first(setup.first, setup.second);
+    first.run(steps / 2);
+    const auto halfway = first.snapshot();
+    first.run(steps - steps / 2);
+
+    sphere::simulation<Real> second(setup.first, setup.second);
+    second.run(steps / 2);
+    const auto halfway2 = second.snapshot();
+    second.run(steps - steps / 2);
+
+    require_eventful(first);
+    if (skin > 0) CHECK(first.rebuilds() < steps); // the skin case really skips rebuilds
+    CHECK(same_bytes(halfway.x, halfway2.x));
+    CHECK(same_bytes(halfway.v, halfway2.v));
+    const std::vector<std::string> diff = differences(record_of(first), record_of(second));
+    INFO("fields that differ: " << Catch::Detail::stringify(diff));
+    CHECK(diff.empty());
+}
+
+TEMPLATE_TEST_CASE("1 and 2 OpenMP threads give bit-identical states", "[determinism][openmp]", float, double)
+{
+    using Real = TestType;
+    thread_count_guard guard;
+    // The host backend runs loops and sorts of fewer than sphere::host_parallel_threshold
+    // (2048) indices on the calling thread, and splits reductions into chunks of 4096: the
+    // cases are large enough for every phase to run on both threads.
+    REQUIRE(sphere::host_parallel_threshold <= 2744);
+
+    SECTION("2744 particles, 100 steps")
+    {
+        const std::size_t steps = 100;
+        Real skin = 0;
+        SECTION("skin 0") { skin = 0; }
+        SECTION("skin 0.2 r0") { skin = Real(0.002); }
+        const auto setup = assembly<Real>(14, skin, 5);
+
+        omp_set_num_threads(1);
+        REQUIRE(threads_in_parallel_region() == 1);
+        sphere::simulation<Real> one(setup.first, setup.second);
+        one.run(steps);
+        const auto with_one = record_of(one);
+
+        omp_set_num_threads(2);
+        REQUIRE(threads_in_parallel_region() == 2);
+        sphere::simulation<Real> two(setup.first, setup.second);
+        two.run(steps);
+        const auto with_two = record_of(two);
+
+        require_eventful(one);
+        if (skin > 0) CHECK(one.rebuilds() < steps);
+        const std::vector<std::string> diff = differences(with_one, with_two);
+        INFO("fields that differ: " << Catch::Detail::stringify(diff));
+        CHECK(diff.empty());
+    }
+    SECTION("9261 particles, 30 steps: reductions over 3 chunks of 4096 indices")
+    {
+        const std::size_t steps = 30;
+        const auto setup = assembly<Real>(21, Real(0.002), 6);
+
+        omp_set_num_threads(1);
+        REQUIRE(threads_in_parallel_region() == 1);
+        sphere::simulation<Real> one(setup.first, setup.second);
+        one.run(steps);
+        const auto with_one = record_of(one);
+
+        omp_set_num_threads(2);
+        REQUIRE(threads_in_parallel_region() == 2);
+        sphere::simulation<Real> two(setup.first, setup.second);
+        two.run(steps);
+        const auto with_two = record_of(two);
+
+        const std::vector<std::string> diff = differences(with_one, with_two);
+        INFO("fields that differ: " << Catch::Detail::stringify(diff));
+        CHECK(diff.empty());
+        CHECK(with_one.energy.dissipated_visc > 0);
+    }
+}

@@ -1,0 +1,674 @@
+// Neighbour grid and contact lists.
+//
+// 1. The lists built by the grid hold exactly the pairs of a brute-force O(N^2) search,
+//    |x_i - x_j| < r_i + r_j + skin with the nearest periodic image, for 2400 polydisperse
+//    particles at random (overlapping) positions, for walls on every axis, periodic x and
+//    periodic x and y, with skin 0 and a positive skin.
+// 2. A skin changes when the lists are rebuilt, never the physics: 400 steps of a dense,
+//    frictional, damped polydisperse assembly with skin 0.2 r0 reproduce the skin-0 run, and
+//    every pair that overlaps is listed in the step that evaluates it.
+// 3. The tangential history of a contact is keyed by the partner's index: it survives
+//    rebuilds that insert and remove other partners in front of it.
+#include <catch2/catch.hpp>
+
+#include "support.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <random>
+#include <set>
+#include <sstream>
+#include <string>
+#include <type_traits>
+#include <utility>
+#include <vector>
+
+namespace {
+
+using sphere::boundary;
+using sphere::vec3;
+
+constexpr double r0 = 0.01; // mean particle radius (m)
+
+/// 2400 particles, radii uniform in [0.5, 1.5] r0, uniform random centres in a 36 x 30 x 33 r0
+/// box whose corner is not at the origin (solid fraction ~0.35, overlaps allowed). On wall
+/// axes the centres lie in [lo, hi], a few exactly on lo or hi; on periodic axes a few lie
+/// up to 0.4 r0 outside the box (the simulation wraps them) and many pairs straddle the
+/// boundary.
+template <class Real>
+std::vector<sphere::particle<Real>> random_cloud(const sphere::world<Real>& box, std::uint32_t seed)
+{
+    std::mt19937 gen(seed);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    const std::size_t n = 2400;
+    std::vector<sphere::particle<Real>> ps(n);
+    for (std::size_t i = 0; i < n; ++i) {
+        sphere::particle<Real>& p = ps[i];
+        p.radius = static_cast<Real>(r0 * (0.5 + unit(gen)));
+        p.density = Real(2500);
+        for (int a = 0; a < 3; ++a) {
+            const double lo = box.lo[a], hi = box.hi[a];
+            double c = lo + (hi - lo) * unit(gen);
+            if (i % 97 == 0) c = (i / 97) % 2 == 0 ? lo : hi;                        // on a face
+            if (i % 89 == 0 && box.periodic(a)) c = (i / 89) % 2 == 0 ? lo - 0.4 * r0 : hi + 0.3 * r0;
+            p.position[a] = static_cast<Real>(c);
+        }
+        if (!box.periodic(0)) p.position.x = std::min(std::max(p.position.x, box.lo.x), box.hi.x);
+        if (!box.periodic(1)) p.position.y = std::min(std::max(p.position.y, box.lo.y), box.hi.y);
+        if (!box.periodic(2)) p.position.z = std::min(std::max(p.position.z, box.lo.z), box.hi.z);
+    }
+    return ps;
+}
+
+template <class Real>
+sphere::world<Real> cloud_box(bool periodic_x, bool periodic_y)
+{
+    sphere::world<Real> w;
+    w.lo = {Real(-0.13), Real(0.05), Real(-0.2)};
+    w.hi = {w.lo.x + Real(36 * r0), w.lo.y + Real(30 * r0), w.lo.z + Real(33 * r0)};
+    w.axis[0] = periodic_x ? boundary::periodic : boundary::wall;
+    w.axis[1] = periodic_y ? boundary::periodic : boundary::wall;
+    w.axis[2] = boundary::wall;
+    return w;
+}
+
+/// The reference: every pair with |x_i - x_j| < r_i + r_j + skin, by an O(N^2) search in
+/// double precision on the positions and radii the simulation holds (after wrapping), with
+/// the nearest image d - L round(d / L) on periodic axes. Pairs whose squared distance lies
+/// within a relative `band` of the squared reach are "ambiguous": the simulation compares in
+/// Real, so round-off may put them on either side; they are kept apart and reported.
+struct reference_pairs {
+    std::vector<std::set<unsigned>> certain;   ///< per particle: partners surely within reach
+    std::vector<std::set<unsigned>> ambiguous; ///< per particle: partners at the threshold
+    std::size_t pairs = 0;                     ///< certain pairs (each counted once)
+    std::size_t across_boundary = 0;           ///< certain pairs that touch through a periodic face
+    std::size_t ambiguous_pairs = 0;
+};
+
+template <class Real>
+reference_pairs brute_force(const sphere::particle_snapshot<Real>& s, const sphere::world<Real>& box, double skin,
+                            double band)
+{
+    const std::size_t n = s.size();
+    reference_pairs ref;
+    ref.certain.resize(n);
+    ref.ambiguous.resize(n);
+    for (std::size_t i = 0; i < n; ++i)
+        for (std::size_t j = i + 1; j < n; ++j) {
+            double d2 = 0;
+            bool wrapped = false;
+            for (int a = 0; a < 3; ++a) {
+                double d = static_cast<double>(s.x[i].xyz()[a]) - static_cast<double>(s.x[j].xyz()[a]);
+                if (box.periodic(a)) {
+                    const double len = static_cast<double>(box.hi[a]) - static_cast<double>(box.lo[a]);
+                    const double shift = len * std::round(d / len);
+                    wrapped = wrapped || shift != 0;
+                    d -= shift;
+                }
+                d2 += d * d;
+            }
+            const double reach = static_cast<double>(s.x[i].w) + static_cast<double>(s.x[j].w) + skin;
+            const double q = d2 / (reach * reach) - 1;
+            if (std::abs(q) <= band) {
+                ref.ambiguous[i].insert(static_cast<unsigned>(j));
+                ref.ambiguous[j].insert(static_cast<unsigned>(i));
+                ++ref.ambiguous_pairs;
+            } else if (q < 0) {
+                ref.certain[i].insert(static_cast<unsigned>(j));
+                ref.certain[j].insert(static_cast<unsigned>(i));
+                ++ref.pairs;
+                if (wrapped) ++ref.across_boundary;
+            }
+        }
+    return ref;
+}
+
+/// Compares the simulation's contact lists with the reference; returns a description of every
+/// discrepancy (empty when the lists are exact). Also checks the documented layout: entry k
+/// of particle i at i * capacity + k, at most `capacity` entries, sorted by partner index
+/// with no duplicates and no self-entry.
+template <class Lists>
+std::vector<std::string> compare_lists(const Lists& lists, const reference_pairs& ref)
+{
+    const std::vector<unsigned> count = lists.counts();
+    const std::vector<unsigned> partner = lists.partners();
+    const std::size_t cap = lists.capacity();
+    std::vector<std::string> bad;
+    auto report = [&](std::size_t i, const std::string& what) {
+        if (bad.size() < 20) {
+            std::ostringstream o;
+            o << "particle " << i << ": " << what;
+            bad.push_back(o.str());
+        } else if (bad.size() == 20) {
+            bad.push_back("...");
+        }
+    };
+    for (std::size_t i = 0; i < ref.certain.size(); ++i) {
+        if (count[i] > cap) {
+            report(i, "count " + std::to_string(count[i]) + " exceeds the capacity");
+            continue;
+        }
+        std::set<unsigned> listed;
+        for (unsigned k = 0; k < count[i]; ++k) {
+            const unsigned j = partner[i * cap + k];
+            if (k > 0 && !(partner[i * cap + k - 1] < j)) report(i, "list not strictly ascending at entry " + std::to_string(k));
+            if (j == i) report(i, "lists itself");
+            listed.insert(j);
+        }
+        for (unsigned j : ref.certain[i])
+            if (!listed.count(j)) report(i, "misses partner " + std::to_string(j));
+        for (unsigned j : listed)
+            if (!ref.certain[i].count(j) && !ref.ambiguous[i].count(j))
+                report(i, "lists " + std::to_string(j) + ", which is out of reach");
+    }
+    return bad;
+}
+
+} // namespace
+
+TEMPLATE_TEST_CASE("contact lists hold exactly the brute-force pairs within r_i + r_j + skin", "[grid][contacts]",
+                   float, double)
+{
+    using Real = TestType;
+    // Pairs within this relative distance of the threshold (in squared distance) may fall
+    // either way in Real arithmetic: a few ulps of Real (float 6e-8, double 1e-16), with
+    // a wide margin. With random positions none is expected (~1e-3 pairs for float).
+    const double band = std::is_same<Real, float>::value ? 1e-5 : 1e-12;
+
+    struct layout {
+        const char* name;
+        bool periodic_x, periodic_y;
+    };
+    const layout layouts[] = {{"walls on every axis", false, false},
+                              {"periodic x", true, false},
+                              {"periodic x and y", true, true}};
+    struct search {
+        const char* name;
+        double skin;      // (m)
+        double cell_size; // (m), 0 = automatic
+    };
+    const search searches[] = {{"skin 0", 0.0, 0.0},
+                               {"skin 0.3 r0", 0.3 * r0, 0.0},
+                               {"skin 0.3 r0, cells 1.5x wider than needed", 0.3 * r0, 1.5 * (3 * r0 + 0.3 * r0)}};
+
+    std::uint32_t seed = 20240601;
+    for (const layout& l : layouts)
+        for (const search& q : searches) {
+            ++seed;
+            DYNAMIC_SECTION(l.name << ", " << q.name)
+            {
+                sphere::settings<Real> s = sphere_test::box_settings<Real>();
+                s.box = cloud_box<Real>(l.periodic_x, l.periodic_y);
+                s.skin = static_cast<Real>(q.skin);
+                s.cell_size = static_cast<Real>(q.cell_size);
+                s.contact_capacity = 24;
+                sphere::simulation<Real> sim(s, random_cloud<Real>(s.box, seed));
+
+                const sphere::particle_snapshot<Real> snap = sim.snapshot();
+                // Wrapped positions: every coordinate on a periodic axis lies in [lo, hi),
+                // up to the round-off of the wrap (hi - (hi - lo) may differ from lo by an ulp;
+                // the tolerance is 4 ulps of the largest coordinate).
+                for (std::size_t i = 0; i < snap.size(); ++i)
+                    for (int a = 0; a < 3; ++a)
+                        if (s.box.periodic(a)) {
+                            const Real ulps = 4 * std::numeric_limits<Real>::epsilon() *
+                                              std::max(std::abs(s.box.lo[a]), std::abs(s.box.hi[a]));
+                            REQUIRE(snap.x[i].xyz()[a] >= s.box.lo[a] - ulps);
+                            REQUIRE(snap.x[i].xyz()[a] < s.box.hi[a]);
+                        }
+
+                const reference_pairs ref = brute_force(snap, s.box, static_cast<double>(s.skin), band);
+                INFO("reference: " << ref.pairs << " pairs, " << ref.across_boundary
+                                   << " through a periodic face, " << ref.ambiguous_pairs << " at the threshold");
+                // The case exercises what it claims: thousands of pairs, many of them across
+                // the periodic faces when there are any.
+                REQUIRE(ref.pairs > 2000);
+                if (l.periodic_x) REQUIRE(ref.across_boundary > 50);
+                else REQUIRE(ref.across_boundary == 0);
+
+                const std::vector<std::string> bad = compare_lists(sim.contacts(), ref);
+                std::ostringstream msg;
+                for (const std::string& b : bad) msg << b << '\n';
+                INFO(msg.str());
+                REQUIRE(bad.empty());
+
+                // The counts equal the reference's partner counts.
+                const std::vector<unsigned> count = sim.contacts().counts();
+                std::size_t listed = 0, miscounted = 0;
+                for (std::size_t i = 0; i < snap.size(); ++i) {
+                    listed += count[i];
+                    if (count[i] < ref.certain[i].size() ||
+                        count[i] > ref.certain[i].size() + ref.ambiguous[i].size())
+                        ++miscounted;
+                }
+                CHECK(miscounted == 0);
+                CHECK(listed >= 2 * ref.pairs);
+                CHECK(listed <= 2 * (ref.pairs + ref.ambiguous_pairs));
+                CHECK(sim.rebuilds() == 1);
+            }
+        }
+}
+
+namespace {
+
+/// A dense polydisperse assembly: 2000 particles, radii uniform in [0.5, 1.5] r0, placed by
+/// random sequential addition (largest first, no overlaps, clear of the walls) in a closed
+/// cube of side 30 r0 (solid fraction 0.39), with random velocities N(0, 1 m/s) and angular
+/// velocities N(0, 100 rad/s), under gravity. Particle indices are shuffled, so that index
+/// and position are unrelated and the grid must reorder.
+template <class Real>
+std::pair<sphere::settings<Real>, std::vector<sphere::particle<Real>>> dense_assembly(std::uint32_t seed)
+{
+    const std::size_t n = 2000;
+    const double half = 15 * r0;
+    sphere::settings<Real> s;
+    s.box.lo = {Real(-half), Real(-half), Real(-half)};
+    s.box.hi = {Real(half), Real(half), Real(half)};
+    s.contact.k_n = Real(1e5);
+    s.contact.k_t = Real(1e5 * 2.0 / 7.0);
+    s.contact.gamma_n = Real(5);
+    s.contact.gamma_t = Real(2);
+    s.contact.mu_s = Real(0.5);
+    s.contact.mu_d = Real(0.4);
+    s.wall = s.contact;
+    s.wall.mu_s = Real(0.3);
+    s.wall.mu_d = Real(0.3);
+    s.gravity = {Real(0), Real(0), Real(-9.81)};
+    s.contact_capacity = 24;
+
+    std::mt19937 gen(seed);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    std::normal_distribution<double> normal(0.0, 1.0);
+    std::vector<double> radii(n);
+    for (double& r : radii) r = r0 * (0.5 + unit(gen));
+    std::sort(radii.rbegin(), radii.rend());
+
+    // Random sequential addition with a cell list of 3 r0 cells (the largest diameter).
+    const int cells = static_cast<int>(2 * half / (3 * r0));
+    const double width = 2 * half / cells;
+    std::vector<std::vector<std::size_t>> cell(static_cast<std::size_t>(cells * cells * cells));
+    std::vector<vec3<double>> centre;
+    auto cell_coord = [&](double c) { return std::min(cells - 1, std::max(0, static_cast<int>((c + half) / width))); };
+    for (const double r : radii) {
+        for (;;) {
+            const vec3<double> c{-half + r + (2 * (half - r)) * unit(gen), -half + r + (2 * (half - r)) * unit(gen),
+                                 -half + r + (2 * (half - r)) * unit(gen)};
+            const int ix = cell_coord(c.x), iy = cell_coord(c.y), iz = cell_coord(c.z);
+            bool free = true;
+            for (int z = std::max(0, iz - 1); free && z <= std::min(cells - 1, iz + 1); ++z)
+                for (int y = std::max(0, iy - 1); free && y <= std::min(cells - 1, iy + 1); ++y)
+                    for (int x = std::max(0, ix - 1); free && x <= std::min(cells - 1, ix + 1); ++x)
+                        for (std::size_t j : cell[static_cast<std::size_t>((z * cells + y) * cells + x)]) {
+                            const vec3<double> d = c - centre[j];
+                            const double reach = r + radii[j];
+                            if (sphere::norm2(d) < reach * reach * 1.0001) {
+                                free = false;
+                                break;
+                            }
+                        }
+            if (!free) continue;
+            cell[static_cast<std::size_t>((iz * cells + iy) * cells + ix)].push_back(centre.size());
+            centre.push_back(c);
+            break;
+        }
+    }
+
+    std::vector<sphere::particle<Real>> ps(n);
+    for (std::size_t i = 0; i < n; ++i) {
+        sphere::particle<Real>& p = ps[i];
+        p.radius = static_cast<Real>(radii[i]);
+        p.density = Real(2500);
+        p.position = sphere::vec_cast<Real>(centre[i]);
+        for (int a = 0; a < 3; ++a) {
+            p.velocity[a] = static_cast<Real>(normal(gen));
+            p.angular_velocity[a] = static_cast<Real>(100 * normal(gen));
+        }
+    }
+    std::shuffle(ps.begin(), ps.end(), gen);
+    return {s, ps};
+}
+
+/// Largest |a - b| over a field, relative to the largest |b| (0 when both are zero).
+template <class V>
+double max_rel_diff3(const std::vector<V>& a, const std::vector<V>& b)
+{
+    double diff = 0, scale = 0;
+    for (std::size_t i = 0; i < a.size(); ++i)
+        for (int c = 0; c < 3; ++c) {
+            diff = std::max(diff, std::abs(static_cast<double>(a[i][c]) - static_cast<double>(b[i][c])));
+            scale = std::max(scale, std::abs(static_cast<double>(b[i][c])));
+        }
+    return scale > 0 ? diff / scale : diff;
+}
+
+template <class T>
+double max_rel_diff1(const std::vector<T>& a, const std::vector<T>& b)
+{
+    double diff = 0, scale = 0;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+        diff = std::max(diff, std::abs(static_cast<double>(a[i]) - static_cast<double>(b[i])));
+        scale = std::max(scale, std::abs(static_cast<double>(b[i])));
+    }
+    return scale > 0 ? diff / scale : diff;
+}
+
+/// Pairs (i < j) that overlap, |x_i - x_j| < r_i + r_j, in double: an exhaustive search
+/// over the pairs whose x coordinates differ by less than the largest diameter (sort and
+/// sweep along x; no pair farther apart in x can overlap).
+template <class Real>
+std::vector<std::pair<unsigned, unsigned>> overlapping_pairs(const sphere::particle_snapshot<Real>& s)
+{
+    std::vector<unsigned> order(s.size());
+    double largest = 0;
+    for (std::size_t i = 0; i < s.size(); ++i) {
+        order[i] = static_cast<unsigned>(i);
+        largest = std::max(largest, 2 * static_cast<double>(s.x[i].w));
+    }
+    std::sort(order.begin(), order.end(), [&](unsigned a, unsigned b) { return s.x[a].x < s.x[b].x; });
+    std::vector<std::pair<unsigned, unsigned>> out;
+    for (std::size_t u = 0; u < order.size(); ++u)
+        for (std::size_t v = u + 1; v < order.size(); ++v) {
+            const unsigned i = order[u], j = order[v];
+            if (static_cast<double>(s.x[j].x) - static_cast<double>(s.x[i].x) > largest) break;
+            double d2 = 0;
+            for (int a = 0; a < 3; ++a) {
+                const double d = static_cast<double>(s.x[i].xyz()[a]) - static_cast<double>(s.x[j].xyz()[a]);
+                d2 += d * d;
+            }
+            const double reach = static_cast<double>(s.x[i].w) + static_cast<double>(s.x[j].w);
+            if (d2 < reach * reach) out.emplace_back(std::min(i, j), std::max(i, j));
+        }
+    return out;
+}
+
+template <class Lists>
+bool listed(const Lists& count_partner, std::size_t cap, unsigned i, unsigned j)
+{
+    const unsigned* begin = count_partner.second.data() + i * cap;
+    return std::binary_search(begin, begin + count_partner.first[i], j);
+}
+
+} // namespace
+
+TEMPLATE_TEST_CASE("a skin skips rebuilds without changing the dynamics of a dense frictional assembly",
+                   "[grid][contacts][history]", float, double)
+{
+    using Real = TestType;
+    const std::size_t steps = 400;
+    auto setup = dense_assembly<Real>(7);
+    sphere::settings<Real> s0 = setup.first, s1 = setup.first;
+    s0.skin = 0;
+    s1.skin = static_cast<Real>(0.2 * r0);
+    sphere::simulation<Real> no_skin(s0, setup.second);
+    sphere::simulation<Real> skin(s1, setup.second);
+    REQUIRE(no_skin.dt() == skin.dt());
+
+    // Verlet-list safety, checked in the skin run at every step: every pair that overlaps
+    // after step k is listed during step k + 1 (the lists read after step k + 1 are the
+    // ones step k + 1 evaluated: lists are only rebuilt at the start of a step).
+    std::vector<std::pair<unsigned, unsigned>> overlapping = overlapping_pairs(skin.snapshot());
+    std::size_t missed = 0, checked = 0, max_overlapping = 0;
+    for (std::size_t k = 0; k < steps; ++k) {
+        no_skin.step();
+        skin.step();
+        const auto lists = std::make_pair(skin.contacts().counts(), skin.contacts().partners());
+        for (const auto& pr : overlapping) {
+            ++checked;
+            if (!listed(lists, skin.contacts().capacity(), pr.first, pr.second) ||
+                !listed(lists, skin.contacts().capacity(), pr.second, pr.first))
+                ++missed;
+        }
+        overlapping = overlapping_pairs(skin.snapshot());
+        max_overlapping = std::max(max_overlapping, overlapping.size());
+    }
+    INFO("rebuilds with skin 0: " << no_skin.rebuilds() << ", with skin 0.2 r0: " << skin.rebuilds() << " in "
+                                  << steps << " steps; up to " << max_overlapping << " overlapping pairs");
+    CHECK(missed == 0);
+    CHECK(checked > 100000); // the assembly is in contact most of the time
+
+    // Skin 0 rebuilds before every step but the first (the lists built at setup serve it);
+    // the skin run rebuilds only when some particle moved more than skin / 2, here every
+    // ~20-30 steps (the fastest particles move ~4 m/s, 0.1 r0 in ~30 steps of 8.6e-6 s).
+    CHECK(no_skin.rebuilds() == steps);
+    CHECK(skin.rebuilds() < steps / 4);
+    CHECK(skin.rebuilds() > 3); // history was carried over more than once
+
+    // Same physics. Listed partners that do not overlap contribute nothing, and the lists
+    // are sorted by partner index, so both runs sum the same forces in the same order: the
+    // two runs must agree to round-off, which here means identical arithmetic. The bound is
+    // 1e-10 relative (of the largest value of each field) for double; for float the same
+    // bound is used, which is only met if the arithmetic is identical (float eps 6e-8), as
+    // the argument above says it must be.
+    const double tol = 1e-10;
+    const sphere::particle_snapshot<Real> a = skin.snapshot(), b = no_skin.snapshot();
+    std::vector<vec3<Real>> xa(a.size()), xb(b.size());
+    for (std::size_t i = 0; i < a.size(); ++i) {
+        xa[i] = a.position(i);
+        xb[i] = b.position(i);
+    }
+    // Positions: relative to r0 (the box is centred on the origin, so coordinates themselves
+    // pass through zero).
+    double dx = 0;
+    for (std::size_t i = 0; i < a.size(); ++i)
+        for (int c = 0; c < 3; ++c) dx = std::max(dx, std::abs(double(xa[i][c]) - double(xb[i][c])) / r0);
+    CHECK(dx <= tol);
+    CHECK(max_rel_diff3(a.v, b.v) <= tol);
+    CHECK(max_rel_diff3(a.omega, b.omega) <= tol);
+    CHECK(max_rel_diff3(a.v_sync, b.v_sync) <= tol);
+    CHECK(max_rel_diff3(a.omega_sync, b.omega_sync) <= tol);
+    CHECK(max_rel_diff3(a.force, b.force) <= tol);
+    CHECK(max_rel_diff3(a.torque, b.torque) <= tol);
+    CHECK(max_rel_diff1(a.e_visc, b.e_visc) <= tol);
+    CHECK(max_rel_diff1(a.e_fric, b.e_fric) <= tol);
+
+    // The tangential histories of the overlapping pairs agree too (the skin run carried them
+    // over ~15 rebuilds, the skin-0 run over 400), and there are plenty of them: sticking
+    // and sliding contacts with non-zero tangential displacement.
+    const std::size_t cap = s1.contact_capacity;
+    const auto c0 = no_skin.contacts().counts(), c1 = skin.contacts().counts();
+    const auto p0 = no_skin.contacts().partners(), p1 = skin.contacts().partners();
+    const auto h0 = no_skin.contacts().histories(), h1 = skin.contacts().histories();
+    double hdiff = 0, hscale = 0;
+    std::size_t sliding = 0, sticking = 0, unmatched = 0;
+    for (std::size_t i = 0; i < a.size(); ++i)
+        for (unsigned k = 0; k < c0[i]; ++k) {
+            const unsigned j = p0[i * cap + k];
+            const unsigned* begin = p1.data() + i * cap;
+            const unsigned* at = std::lower_bound(begin, begin + c1[i], j);
+            if (at == begin + c1[i] || *at != j) {
+                ++unmatched;
+                continue;
+            }
+            const sphere::vec4<Real> u = h0[i * cap + k], w = h1[i * cap + (at - begin)];
+            const double du[4] = {double(u.x) - w.x, double(u.y) - w.y, double(u.z) - w.z, double(u.w) - w.w};
+            for (double d : du) hdiff = std::max(hdiff, std::abs(d));
+            hscale = std::max({hscale, std::abs(double(u.x)), std::abs(double(u.y)), std::abs(double(u.z))});
+            const bool moved = u.x != 0 || u.y != 0 || u.z != 0;
+            if (moved && u.w != 0) ++sliding;
+            if (moved && u.w == 0) ++sticking;
+        }
+    INFO("contacts: " << sticking << " sticking, " << sliding << " sliding; largest |delta_t| " << hscale << " m");
+    CHECK(unmatched == 0); // every skin-0 partner (all within r_i + r_j) is in the skin lists
+    CHECK(sliding > 100);
+    CHECK(sticking > 100);
+    CHECK(hdiff <= tol * hscale);
+}
+
+namespace {
+
+/// Where `j` sits in particle i's list (its entry index k), or -1.
+template <class Sim>
+int entry_of(const Sim& sim, unsigned i, unsigned j)
+{
+    const auto count = sim.contacts().counts();
+    const auto partner = sim.contacts().partners();
+    const std::size_t cap = sim.contacts().capacity();
+    for (unsigned k = 0; k < count[i] && k < cap; ++k)
+        if (partner[i * cap + k] == j) return static_cast<int>(k);
+    return -1;
+}
+
+} // namespace
+
+TEMPLATE_TEST_CASE("the tangential history of a contact survives rebuilds that reorder its list",
+                   "[grid][contacts][history]", float, double)
+{
+    using Real = TestType;
+    using P = sphere_test::set_p<Real>;
+    // A sliding pair with known kinematics: A (prescribed) sits at the origin and spins at
+    // omega_z = w; B (fixed) touches it on +x with overlap delta = 1e-4 m. The contact point
+    // of A moves at v_t = (r - delta / 2) w along +y relative to B, the normal overlap never
+    // changes, so (docs/physics.md, "Tangential force"; VALIDATION D9):
+    //   sticking (|k_t delta_t| < mu_s f_n): delta_t = n_steps dt v_t y_hat;
+    //   sliding: delta_t = mu_d f_n / k_t y_hat (f_t = -k_t delta_t = -mu_d f_n y_hat), and
+    //   B's entry holds the opposite displacement.
+    // Meanwhile 10 other particles sweep through A's surface, entering and leaving A's list
+    // in front of and behind the A-B entry, while the grid re-sorts them at every rebuild
+    // (they cross cells). The A-B contact does not depend on them: its history must follow
+    // the analytic values exactly as if nothing else were there.
+    const Real r = P::radius;
+    const double delta = 1e-4;
+    const double w = 1.0; // rad/s: v_t = 0.00995 m/s
+
+    sphere::settings<Real> s = sphere_test::box_settings<Real>(Real(0.1));
+    s.contact.mu_s = Real(0.4);
+    s.contact.mu_d = Real(0.3);
+    s.wall.mu_s = Real(0.3);
+    s.wall.mu_d = Real(0.3);
+
+    // 10 prescribed passers sweep through A's surface along straight lines parallel to y
+    // (even k) or z (odd k), at closest distances 0.012-0.0192 m from A's centre (A's contact
+    // reach is 0.02 m), on the -x side, at staggered times and speeds, so that none, some or
+    // all of them touch A at a time. All kinematics are prescribed: no force changes any motion.
+    std::vector<sphere::particle<Real>> passers;
+    for (int k = 0; k < 10; ++k) {
+        const double rho = 0.012 + 0.0008 * k;             // closest distance to A's centre (m)
+        const double theta = (-60.0 + 13.0 * k) * 3.14159265358979 / 180; // around the -x axis
+        const double start = -0.03 - 0.002 * k;            // m along the line
+        const double speed = 0.6 + 0.05 * k;               // m/s
+        vec3<double> x{-rho * std::cos(theta), 0, 0}, v{0, 0, 0};
+        if (k % 2 == 0) { x.z = rho * std::sin(theta); x.y = start; v.y = speed; }
+        else { x.y = rho * std::sin(theta); x.z = start; v.z = speed; }
+        sphere::particle<Real> p = sphere_test::ball<Real>(sphere::vec_cast<Real>(x), sphere::vec_cast<Real>(v));
+        p.kind = sphere::motion::prescribed;
+        passers.push_back(p);
+    }
+    sphere::particle<Real> a = sphere_test::ball<Real>({0, 0, 0});
+    a.kind = sphere::motion::prescribed;
+    a.angular_velocity = {0, 0, Real(w)};
+    sphere::particle<Real> b = sphere_test::ball<Real>({static_cast<Real>(2 * r - delta), 0, 0});
+    b.kind = sphere::motion::fixed;
+    // Indices: passers 0-4, A = 5, B = 6, passers 7-11: passers enter the lists of A and B
+    // both in front of and behind the A-B entry.
+    std::vector<sphere::particle<Real>> ps(passers.begin(), passers.begin() + 5);
+    const unsigned ia = 5, ib = 6;
+    ps.push_back(a);
+    ps.push_back(b);
+    ps.insert(ps.end(), passers.begin() + 5, passers.end());
+
+    SECTION("skin 0")
+    {
+        s.skin = 0;
+    }
+    SECTION("skin 0.5 r")
+    {
+        s.skin = Real(0.5) * r;
+    }
+    sphere::simulation<Real> sim(s, ps);
+
+    // Expected values from the positions the simulation holds.
+    const auto snap0 = sim.snapshot();
+    const double dist_ab = static_cast<double>(snap0.x[ib].x) - static_cast<double>(snap0.x[ia].x);
+    const double overlap = 2 * static_cast<double>(r) - dist_ab;
+    const double fn = static_cast<double>(s.contact.k_n) * overlap;
+    const double kt = static_cast<double>(s.contact.k_t);
+    const double vt = (static_cast<double>(r) - overlap / 2) * w;
+    const double dt = static_cast<double>(sim.dt());
+    const double slip = static_cast<double>(s.contact.mu_s) * fn / kt; // 1.4e-4 m
+    const std::size_t stick_steps = static_cast<std::size_t>(slip / (vt * dt)); // ~580
+    const std::size_t steps = 2000;
+
+    // Float: the displacement is a sum of ~500 float increments (relative error ~n eps/2
+    // ~1e-5) and f_n depends on an overlap 1e-4 m resolved from coordinates 0.02 m
+    // (float ulp 1.9e-9 m): 1e-4 relative. Double: 1e-9.
+    const double tol = std::is_same<Real, float>::value ? 1e-4 : 1e-9;
+
+    std::set<int> entries_of_b; // the entry index of B in A's list over the run
+    std::size_t rebuilds_before = sim.rebuilds();
+    std::size_t others_listed = 0, steps_with_others = 0;
+    for (std::size_t n = 1; n <= steps; ++n) {
+        sim.step();
+        const int kb = entry_of(sim, ia, ib);
+        REQUIRE(kb >= 0);
+        entries_of_b.insert(kb);
+        const std::size_t others = sim.contacts().counts()[ia] - 1;
+        others_listed = std::max(others_listed, others);
+        if (others > 0) ++steps_with_others;
+        const int ka = entry_of(sim, ib, ia);
+        REQUIRE(ka >= 0);
+        const std::size_t cap = sim.contacts().capacity();
+        const auto h = sim.contacts().histories();
+        const sphere::vec4<Real> ha = h[ia * cap + kb], hb = h[ib * cap + ka];
+        if (n + 20 < stick_steps) {
+            // Sticking: delta_t = n dt v_t along +y on A, -y on B.
+            const double expect = static_cast<double>(n) * dt * vt;
+            INFO("step " << n << " (sticking)");
+            REQUIRE(ha.w == 0);
+            CHECK(sphere_test::rel_err(ha.y, expect) < tol);
+            CHECK(sphere_test::rel_err(hb.y, -expect) < tol);
+            CHECK(std::abs(double(ha.x)) < tol * expect);
+            CHECK(std::abs(double(ha.z)) < tol * expect);
+        } else if (n > stick_steps + 20) {
+            // Sliding: delta_t = mu_d f_n / k_t along +y (VALIDATION pitfall 4).
+            const double expect = static_cast<double>(s.contact.mu_d) * fn / kt;
+            INFO("step " << n << " (sliding)");
+            REQUIRE(ha.w == 1);
+            REQUIRE(hb.w == 1);
+            CHECK(sphere_test::rel_err(ha.y, expect) < tol);
+            CHECK(sphere_test::rel_err(hb.y, -expect) < tol);
+            CHECK(std::abs(double(ha.x)) < tol * expect);
+            CHECK(std::abs(double(ha.z)) < tol * expect);
+        }
+    }
+    INFO("rebuilds: " << sim.rebuilds() - rebuilds_before << "; entries of B in A's list: " << entries_of_b.size()
+                      << "; up to " << others_listed << " other partners of A, in " << steps_with_others
+                      << " steps; sticking for " << stick_steps << " steps");
+    // The run did what it claims: many rebuilds (every step with skin 0; with the skin
+    // whenever a passer has moved 0.25 r, i.e. every ~170 steps at the fastest 1.05 m/s),
+    // and B's entry moved within A's list.
+    CHECK(sim.rebuilds() - rebuilds_before >= (s.skin > 0 ? 10 : steps - 1));
+    CHECK(entries_of_b.size() >= 3);
+    CHECK(stick_steps > 300);
+    CHECK(stick_steps + 200 < steps);
+}
+
+TEMPLATE_TEST_CASE("a particle given more than one period outside a periodic axis is wrapped or rejected",
+                   "[grid][contacts][world]", float, double)
+{
+    // A centre given two periods outside a periodic axis must be wrapped fully into [lo, hi)
+    // (or rejected), never left outside where the grid would clamp it and miss its contacts
+    // (a wrap of one period did exactly that). Either answer below is correct.
+    using Real = TestType;
+    sphere::settings<Real> s = sphere_test::box_settings<Real>(); // [-0.1, 0.1]^3
+    s.box.axis[0] = sphere::boundary::periodic;
+    const Real L = s.box.hi.x - s.box.lo.x;
+    // Particle 1 sits 0.019 m from particle 0 (radii 0.01: overlap 1 mm) through its image
+    // two periods away.
+    std::vector<sphere::particle<Real>> ps = {sphere_test::ball<Real>({0, 0, 0}),
+                                              sphere_test::ball<Real>({Real(0.019) + 2 * L, 0, 0})};
+    try {
+        sphere::simulation<Real> sim(s, ps);
+        const auto snap = sim.snapshot();
+        CHECK(snap.x[1].x >= s.box.lo.x);
+        CHECK(snap.x[1].x < s.box.hi.x);
+        REQUIRE(sim.contacts().counts()[0] == 1);
+        sim.step();
+        // The overlap pushes particle 0 towards -x: f = k_n 1e-3 m = 100 N.
+        CHECK(sim.snapshot().force[0].x == Approx(-100).epsilon(1e-3));
+    } catch (const sphere::error& e) {
+        CHECK_THAT(e.what(), Catch::Contains("particle 1"));
+    }
+}
