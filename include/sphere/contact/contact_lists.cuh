@@ -5,8 +5,8 @@
 /// entry (tangential displacement, sliding flag). Entries are keyed by the user's particle
 /// indices, so the history survives the grid's reordering. Walls have one entry per face.
 ///
-/// A rebuild that finds more partners than the capacity is reported by `first_overflow`;
-/// the simulation turns that into a sphere::error naming the particle: no contact is dropped
+/// `rebuild` returns the first particle that found more partners than the capacity; the
+/// simulation turns that into a sphere::error naming the particle: no contact is dropped
 /// silently.
 #include <cstddef>
 
