@@ -34,6 +34,28 @@ sphere::settings<Real> box_settings(Real half = Real(0.1))
     return s;
 }
 
+/// A closed box [-half, half]^3 with set-P stiffness, damping (gamma_n = 5, gamma_t = 2 N s/m),
+/// friction (mu_s = 0.5, mu_d = 0.4 between particles, 0.3 at the walls) and gravity: the
+/// dissipative, frictional set-up of the grid and determinism tests.
+template <class Real>
+sphere::settings<Real> frictional_box(double half)
+{
+    sphere::settings<Real> s;
+    s.box.lo = {Real(-half), Real(-half), Real(-half)};
+    s.box.hi = {Real(half), Real(half), Real(half)};
+    s.contact.k_n = Real(1e5);
+    s.contact.k_t = Real(1e5 * 2.0 / 7.0);
+    s.contact.gamma_n = Real(5);
+    s.contact.gamma_t = Real(2);
+    s.contact.mu_s = Real(0.5);
+    s.contact.mu_d = Real(0.4);
+    s.wall = s.contact;
+    s.wall.mu_s = Real(0.3);
+    s.wall.mu_d = Real(0.3);
+    s.gravity = {Real(0), Real(0), Real(-9.81)};
+    return s;
+}
+
 template <class Real>
 sphere::particle<Real> ball(sphere::vec3<Real> position, sphere::vec3<Real> velocity = {0, 0, 0},
                             Real radius = set_p<Real>::radius)

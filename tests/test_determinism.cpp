@@ -50,20 +50,8 @@ std::pair<sphere::settings<Real>, std::vector<sphere::particle<Real>>> assembly(
 {
     const double r0 = 0.01, spacing = 3.04 * r0;
     const double half = per_axis * spacing / 2;
-    sphere::settings<Real> s;
-    s.box.lo = {Real(-half), Real(-half), Real(-half)};
-    s.box.hi = {Real(half), Real(half), Real(half)};
-    s.contact.k_n = Real(1e5);
-    s.contact.k_t = Real(1e5 * 2.0 / 7.0);
-    s.contact.gamma_n = Real(5);
-    s.contact.gamma_t = Real(2);
-    s.contact.mu_s = Real(0.5);
-    s.contact.mu_d = Real(0.4);
-    s.wall = s.contact;
+    sphere::settings<Real> s = sphere_test::frictional_box<Real>(half);
     s.wall.gamma_t = Real(20);
-    s.wall.mu_s = Real(0.3);
-    s.wall.mu_d = Real(0.3);
-    s.gravity = {Real(0), Real(0), Real(-9.81)};
     s.skin = skin;
 
     std::mt19937 gen(seed);
@@ -125,6 +113,19 @@ record<typename Sim::real_type> record_of(const Sim& sim)
             sim.time()};
 }
 
+/// Runs `steps` steps of a set-up on `threads` OpenMP threads and records the result (with
+/// the diagnostics evaluated on the same thread count).
+template <class Real>
+record<Real> run_on_threads(const std::pair<sphere::settings<Real>, std::vector<sphere::particle<Real>>>& setup,
+                            std::size_t steps, int threads)
+{
+    omp_set_num_threads(threads);
+    REQUIRE(threads_in_parallel_region() == threads);
+    sphere::simulation<Real> sim(setup.first, setup.second);
+    sim.run(steps);
+    return record_of(sim);
+}
+
 /// Names of the fields of two records that differ in any bit (empty: identical).
 template <class Real>
 std::vector<std::string> differences(const record<Real>& a, const record<Real>& b)
@@ -158,17 +159,17 @@ std::vector<std::string> differences(const record<Real>& a, const record<Real>& 
 }
 
 /// The run did something worth comparing: contacts formed, friction slid, walls were hit.
-template <class Sim>
-void require_eventful(const Sim& sim)
+template <class Real>
+void require_eventful(const record<Real>& r)
 {
-    const auto e = sim.energy();
-    const auto snap = sim.snapshot();
+    const auto& e = r.energy;
+    const auto& snap = r.snap;
     std::size_t touching = 0;
     for (std::size_t i = 0; i < snap.size(); ++i)
         if (snap.pressure[i] > 0) ++touching;
     INFO("dissipated: viscous " << e.dissipated_visc << " J, frictional " << e.dissipated_fric << " J; "
                                 << touching << " of " << snap.size() << " particles in contact; "
-                                << sim.rebuilds() << " rebuilds in " << sim.steps() << " steps");
+                                << r.rebuilds << " rebuilds in " << r.steps << " steps");
     REQUIRE(e.dissipated_visc > 0);
     REQUIRE(e.dissipated_fric > 0);
     REQUIRE(touching >= 10);
@@ -195,7 +196,7 @@ TEMPLATE_TEST_CASE("two runs of the same input give bit-identical states", "[det
     const auto halfway2 = second.snapshot();
     second.run(steps - steps / 2);
 
-    require_eventful(first);
+    require_eventful(record_of(first));
     if (skin > 0) CHECK(first.rebuilds() < steps); // the skin case really skips rebuilds
     CHECK(same_bytes(halfway.x, halfway2.x));
     CHECK(same_bytes(halfway.v, halfway2.v));
@@ -221,20 +222,11 @@ TEMPLATE_TEST_CASE("1 and 2 OpenMP threads give bit-identical states", "[determi
         SECTION("skin 0.2 r0") { skin = Real(0.002); }
         const auto setup = assembly<Real>(14, skin, 5);
 
-        omp_set_num_threads(1);
-        REQUIRE(threads_in_parallel_region() == 1);
-        sphere::simulation<Real> one(setup.first, setup.second);
-        one.run(steps);
-        const auto with_one = record_of(one);
+        const auto with_one = run_on_threads(setup, steps, 1);
+        const auto with_two = run_on_threads(setup, steps, 2);
 
-        omp_set_num_threads(2);
-        REQUIRE(threads_in_parallel_region() == 2);
-        sphere::simulation<Real> two(setup.first, setup.second);
-        two.run(steps);
-        const auto with_two = record_of(two);
-
-        require_eventful(one);
-        if (skin > 0) CHECK(one.rebuilds() < steps);
+        require_eventful(with_one);
+        if (skin > 0) CHECK(with_one.rebuilds < steps);
         const std::vector<std::string> diff = differences(with_one, with_two);
         INFO("fields that differ: " << Catch::Detail::stringify(diff));
         CHECK(diff.empty());
@@ -244,17 +236,8 @@ TEMPLATE_TEST_CASE("1 and 2 OpenMP threads give bit-identical states", "[determi
         const std::size_t steps = 30;
         const auto setup = assembly<Real>(21, Real(0.002), 6);
 
-        omp_set_num_threads(1);
-        REQUIRE(threads_in_parallel_region() == 1);
-        sphere::simulation<Real> one(setup.first, setup.second);
-        one.run(steps);
-        const auto with_one = record_of(one);
-
-        omp_set_num_threads(2);
-        REQUIRE(threads_in_parallel_region() == 2);
-        sphere::simulation<Real> two(setup.first, setup.second);
-        two.run(steps);
-        const auto with_two = record_of(two);
+        const auto with_one = run_on_threads(setup, steps, 1);
+        const auto with_two = run_on_threads(setup, steps, 2);
 
         const std::vector<std::string> diff = differences(with_one, with_two);
         INFO("fields that differ: " << Catch::Detail::stringify(diff));

@@ -264,19 +264,7 @@ std::pair<sphere::settings<Real>, std::vector<sphere::particle<Real>>> dense_ass
 {
     const std::size_t n = 2000;
     const double half = 15 * r0;
-    sphere::settings<Real> s;
-    s.box.lo = {Real(-half), Real(-half), Real(-half)};
-    s.box.hi = {Real(half), Real(half), Real(half)};
-    s.contact.k_n = Real(1e5);
-    s.contact.k_t = Real(1e5 * 2.0 / 7.0);
-    s.contact.gamma_n = Real(5);
-    s.contact.gamma_t = Real(2);
-    s.contact.mu_s = Real(0.5);
-    s.contact.mu_d = Real(0.4);
-    s.wall = s.contact;
-    s.wall.mu_s = Real(0.3);
-    s.wall.mu_d = Real(0.3);
-    s.gravity = {Real(0), Real(0), Real(-9.81)};
+    sphere::settings<Real> s = sphere_test::frictional_box<Real>(half);
     s.contact_capacity = 24;
 
     std::mt19937 gen(seed);
