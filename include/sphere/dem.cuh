@@ -3,6 +3,7 @@
 /// The DEM half of sphere: `#include <sphere/dem.cuh>` brings in particles, the neighbour
 /// grid, contact laws, walls, integrators, the simulation template and its diagnostics.
 #include "analysis/energy.cuh"
+#include "boundary/wall_control.cuh"
 #include "boundary/walls.cuh"
 #include "boundary/world.cuh"
 #include "contact/contact_lists.cuh"

@@ -3,6 +3,8 @@
 /// Everything a DEM simulation needs besides its particles.
 #include <cstddef>
 
+#include "boundary/wall_control.cuh"
+#include "boundary/walls.cuh"
 #include "boundary/world.cuh"
 #include "contact/params.cuh"
 #include "core/vec.cuh"
@@ -19,6 +21,9 @@ struct settings {
     Real skin = 0;                  ///< contact-list skin (m); 0 rebuilds the lists every step, as sphere
     std::size_t contact_capacity = 32; ///< partners listed per particle (within r_i + r_j + skin)
     Real cell_size = 0;             ///< neighbour-grid cell width (m); 0 selects the largest diameter plus skin
+    /// Motion of each wall face f (axis f / 2, lower face when f is even; the upper wall is
+    /// walls[5]); all fixed by default.
+    wall_control<Real> walls[wall_set<Real>::count];
 };
 
 } // namespace sphere

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "analysis/energy.cuh"
+#include "boundary/wall_control.cuh"
 #include "boundary/walls.cuh"
 #include "contact/contact_lists.cuh"
 #include "contact/interact.cuh"
@@ -34,6 +35,28 @@ struct copy_positions {
     SPHERE_HD void operator()(std::size_t i) const { to[i] = from[i]; }
 };
 
+/// Forces of the particles on the six walls along their axes (N), summed in double.
+struct wall_forces {
+    double f[6];
+    SPHERE_HD wall_forces operator+(const wall_forces& b) const
+    {
+        wall_forces out;
+        for (int k = 0; k < 6; ++k) out.f[k] = f[k] + b.f[k];
+        return out;
+    }
+};
+
+template <class Real>
+struct particle_wall_forces {
+    const Real* wall_force; ///< force of face f on particle i along the axis, at [i * 6 + f]
+    SPHERE_HD wall_forces operator()(std::size_t i) const
+    {
+        wall_forces out;
+        for (int k = 0; k < 6; ++k) out.f[k] = -double(wall_force[i * 6 + k]);
+        return out;
+    }
+};
+
 template <class Real>
 struct set_kinematics {
     particle_view<Real> p;
@@ -48,6 +71,18 @@ struct set_kinematics {
     }
 };
 } // namespace detail
+
+/// Everything of a simulation that evolves in time (the settings and the time step stay).
+template <class Real>
+struct simulation_state {
+    particle_snapshot<Real> particles;
+    std::vector<unsigned> counts, partners;           ///< contact lists (contact_lists layout)
+    std::vector<vec4<Real>> histories, wall_histories; ///< their history entries
+    std::vector<vec4<Real>> x_at_build;               ///< positions when the lists were built
+    wall_set<Real> walls;
+    std::size_t steps = 0, rebuilds = 0;
+    bool needs_rebuild = false;
+};
 
 /// A DEM simulation of spheres.
 ///
@@ -81,6 +116,7 @@ public:
         if (s.contact_capacity < 1) detail::fail("settings.contact_capacity = 0: must be at least 1");
         if (!(s.cell_size >= 0) || !std::isfinite(s.cell_size))
             detail::fail("settings.cell_size = ", s.cell_size, " m: must be non-negative and finite (0 = automatic)");
+        validate_wall_controls(s.walls, s.box);
         if (particles.empty()) detail::fail("no particles: a simulation needs at least one");
         validate_particles(particles, s.box);
 
@@ -123,8 +159,11 @@ public:
                        detail::interact<Real, Law>{p, lists_.view(), settings_.box, walls_, settings_.contact,
                                                    settings_.wall, dt_});
         for_each_index(Policy{}, n, detail::integrate_particles<Real, Integrator>{p, settings_.box, settings_.gravity, dt_});
+        const detail::wall_forces on_walls = transform_reduce(
+            Policy{}, n, detail::particle_wall_forces<Real>{lists_.view().wall_force}, detail::wall_forces{}, plus_op{});
+        advance_walls(walls_, settings_.walls, settings_.box, on_walls.f, time_, dt_, steps_ + 1);
         const detail::step_check<Real> check = transform_reduce(
-            Policy{}, n, detail::check_particle<Real>{p, x_at_build_.data(), settings_.box},
+            Policy{}, n, detail::check_particle<Real>{p, x_at_build_.data(), settings_.box, walls_},
             detail::step_check<Real>{0, ~std::size_t(0)}, detail::combine_checks{});
         ++steps_;
         time_ = static_cast<double>(steps_) * static_cast<double>(dt_);
@@ -179,11 +218,37 @@ public:
     energy_budget<Real> energy() const
     {
         auto& self = const_cast<simulation&>(*this); // views hand out mutable pointers; nothing is written
-        return transform_reduce(Policy{}, size(),
-                                detail::particle_energy<Real, Law>{self.particles_.view(), self.lists_.view(),
-                                                                   settings_.box, walls_, settings_.contact,
-                                                                   settings_.wall, settings_.gravity},
-                                energy_budget<Real>{}, plus_op{});
+        energy_budget<Real> e = transform_reduce(
+            Policy{}, size(),
+            detail::particle_energy<Real, Law>{self.particles_.view(), self.lists_.view(), settings_.box, walls_,
+                                               settings_.contact, settings_.wall, settings_.gravity},
+            energy_budget<Real>{}, plus_op{});
+        for (const wall_face<Real>& w : walls_.face) e.boundary_work += w.work;
+        return e;
+    }
+
+    /// Everything that evolves, for checkpoints: with the same settings, `restore(state())`
+    /// continues bit-identically.
+    simulation_state<Real> state() const
+    {
+        return {particles_.snapshot(), lists_.counts(),    lists_.partners(), lists_.histories(),
+                lists_.wall_histories(), x_at_build_.to_host(), walls_,          steps_,
+                rebuilds_,               needs_rebuild_};
+    }
+
+    /// Continues from a state taken from a simulation with the same settings and particle count.
+    void restore(const simulation_state<Real>& s)
+    {
+        if (s.particles.size() != size())
+            detail::fail("restore: the state holds ", s.particles.size(), " particles, the simulation ", size());
+        particles_.restore(s.particles);
+        lists_.restore(s.counts, s.partners, s.histories, s.wall_histories);
+        x_at_build_.assign(s.x_at_build);
+        walls_ = s.walls;
+        steps_ = s.steps;
+        rebuilds_ = s.rebuilds;
+        needs_rebuild_ = s.needs_rebuild;
+        time_ = static_cast<double>(steps_) * static_cast<double>(dt_);
     }
 
     /// Total linear momentum, sum m v (kg m/s).
@@ -218,7 +283,10 @@ private:
                          x.z, ") m, velocity (", v.x, ", ", v.y, ", ", v.z, ") m/s); reduce the time step");
         detail::fail("step ", steps_, ": particle ", i, " left the world: position (", x.x, ", ", x.y, ", ", x.z,
                      ") m, world [", settings_.box.lo.x, ", ", settings_.box.hi.x, "] x [", settings_.box.lo.y, ", ",
-                     settings_.box.hi.y, "] x [", settings_.box.lo.z, ", ", settings_.box.hi.z, "] m");
+                     settings_.box.hi.y, "] x [", settings_.box.lo.z, ", ", settings_.box.hi.z,
+                     "] m, walls at x [", walls_.face[0].position, ", ", walls_.face[1].position, "], y [",
+                     walls_.face[2].position, ", ", walls_.face[3].position, "], z [", walls_.face[4].position, ", ",
+                     walls_.face[5].position, "] m");
     }
 
     settings<Real> settings_;

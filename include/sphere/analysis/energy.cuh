@@ -23,11 +23,12 @@ struct energy_budget {
     Real dissipated_fric = 0; ///< total frictional dissipation so far
     Real rate_visc = 0;       ///< viscous dissipation rate in the last step
     Real rate_fric = 0;       ///< frictional dissipation rate in the last step
+    Real boundary_work = 0;   ///< work done on the particles by moving walls so far
 
-    /// Mechanical energy plus everything dissipated: constant in a closed system.
+    /// Mechanical energy plus everything dissipated, less the work the walls did: constant.
     SPHERE_HD Real total() const
     {
-        return kinetic + rotational + potential + elastic + dissipated_visc + dissipated_fric;
+        return kinetic + rotational + potential + elastic + dissipated_visc + dissipated_fric - boundary_work;
     }
 
     SPHERE_HD energy_budget operator+(const energy_budget& b) const
@@ -39,7 +40,8 @@ struct energy_budget {
                 dissipated_visc + b.dissipated_visc,
                 dissipated_fric + b.dissipated_fric,
                 rate_visc + b.rate_visc,
-                rate_fric + b.rate_fric};
+                rate_fric + b.rate_fric,
+                boundary_work + b.boundary_work};
     }
 };
 

@@ -12,6 +12,8 @@ struct wall_face {
     bool active = false; ///< true on wall axes, false on periodic ones
     Real position = 0;   ///< coordinate of the plane along its axis (m)
     Real velocity = 0;   ///< velocity of the plane along its axis (m/s)
+    Real force = 0;      ///< force of the particles on the wall along its axis in the last step (N)
+    Real work = 0;       ///< work done by the wall on the particles so far (J)
 };
 
 /// The six faces, copied into kernels by value.

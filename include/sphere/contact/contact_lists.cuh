@@ -9,8 +9,10 @@
 /// simulation turns that into a sphere::error naming the particle: no contact is dropped
 /// silently.
 #include <cstddef>
+#include <vector>
 
 #include "../boundary/walls.cuh"
+#include "../core/error.cuh"
 #include "../core/vec.cuh"
 #include "../exec/algorithms.cuh"
 #include "../exec/buffer.cuh"
@@ -26,7 +28,9 @@ struct contact_view {
     const unsigned* count;  ///< number of partners of particle i (may exceed capacity on overflow)
     const unsigned* partner;///< partner of entry k of particle i at [i * capacity + k]
     vec4<Real>* history;    ///< history of that entry: delta_t (m) in xyz, sliding flag in w
+    vec4<Real>* force;      ///< force of that entry in the last step: f_t (N) in xyz, f_n . n (N) in w
     vec4<Real>* wall_history; ///< history of particle i against wall face f at [i * 6 + f]
+    Real* wall_force;       ///< force of wall face f on particle i along the face's axis (N), [i * 6 + f]
 };
 
 namespace detail {
@@ -134,8 +138,9 @@ public:
     contact_lists() = default;
     contact_lists(std::size_t n, std::size_t capacity)
         : capacity_(capacity), count_(n, 0u), partner_(n * capacity, 0u), history_(n * capacity),
-          wall_history_(n * wall_set<Real>::count, vec4<Real>{0, 0, 0, 0}), new_count_(n, 0u),
-          new_partner_(n * capacity, 0u), new_history_(n * capacity)
+          force_(n * capacity), wall_history_(n * wall_set<Real>::count, vec4<Real>{0, 0, 0, 0}),
+          wall_force_(n * wall_set<Real>::count, Real(0)), new_count_(n, 0u), new_partner_(n * capacity, 0u),
+          new_history_(n * capacity)
     {
     }
 
@@ -163,7 +168,9 @@ public:
 
     contact_view<Real> view()
     {
-        return {capacity_, count_.data(), partner_.data(), history_.data(), wall_history_.data()};
+        return {capacity_,     count_.data(),        partner_.data(),
+                history_.data(), force_.data(),        wall_history_.data(),
+                wall_force_.data()};
     }
 
     /// Host copies for checkpoints and tests.
@@ -171,11 +178,28 @@ public:
     std::vector<unsigned> partners() const { return partner_.to_host(); }
     std::vector<vec4<Real>> histories() const { return history_.to_host(); }
     std::vector<vec4<Real>> wall_histories() const { return wall_history_.to_host(); }
+    std::vector<vec4<Real>> forces() const { return force_.to_host(); }
+    std::vector<Real> wall_forces() const { return wall_force_.to_host(); }
+
+    /// Replaces the lists and their history (for restarts); sizes must match this store's.
+    void restore(const std::vector<unsigned>& counts, const std::vector<unsigned>& partners,
+                 const std::vector<vec4<Real>>& histories, const std::vector<vec4<Real>>& wall_histories)
+    {
+        if (counts.size() != count_.size() || partners.size() != partner_.size() ||
+            histories.size() != history_.size() || wall_histories.size() != wall_history_.size())
+            detail::fail("contact lists: restored arrays have the wrong sizes for ", count_.size(),
+                         " particles with capacity ", capacity_);
+        count_.assign(counts);
+        partner_.assign(partners);
+        history_.assign(histories);
+        wall_history_.assign(wall_histories);
+    }
 
 private:
     std::size_t capacity_ = 0;
     buffer<unsigned, Policy> count_, partner_;
-    buffer<vec4<Real>, Policy> history_, wall_history_;
+    buffer<vec4<Real>, Policy> history_, force_, wall_history_;
+    buffer<Real, Policy> wall_force_;
     buffer<unsigned, Policy> new_count_, new_partner_;
     buffer<vec4<Real>, Policy> new_history_;
 };

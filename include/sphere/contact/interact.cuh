@@ -57,8 +57,10 @@ struct interact {
                 fn_sum += r.fn;
                 visc += r.visc_rate / 2;
                 fric += r.fric_rate / 2;
+                c.force[e] = {r.tangential.x, r.tangential.y, r.tangential.z, dot(r.normal, n)};
             } else {
                 h = vec4<Real>{0, 0, 0, 0}; // a contact that has ended forgets its history
+                c.force[e] = vec4<Real>{0, 0, 0, 0};
             }
             c.history[e] = h;
         }
@@ -72,6 +74,7 @@ struct interact {
             const Real dist = (xi.xyz()[a] - wall.position) * n[a];
             const Real delta_n = dist - xi.w;
             vec4<Real> h = c.wall_history[e];
+            Real on_axis = 0;
             if (delta_n < Real(0)) {
                 contact_motion<Real> m{n, delta_n, vi + dist * cross(n, wi), (p.v[i] + dist * cross(n, p.omega[i])) * dt};
                 m.velocity[a] -= wall.velocity;
@@ -82,10 +85,12 @@ struct interact {
                 fn_sum += r.fn;
                 visc += r.visc_rate;
                 fric += r.fric_rate;
+                on_axis = (r.normal + r.tangential)[a];
             } else {
                 h = vec4<Real>{0, 0, 0, 0};
             }
             c.wall_history[e] = h;
+            c.wall_force[e] = on_axis;
         }
 
         p.force[i] = force;

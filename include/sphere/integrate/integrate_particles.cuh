@@ -5,6 +5,7 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "../boundary/walls.cuh"
 #include "../boundary/world.cuh"
 #include "../particles/state.cuh"
 
@@ -51,7 +52,7 @@ struct integrate_particles {
 };
 
 /// Result of the post-step check: the largest squared displacement since the contact lists
-/// were built (m^2), and the first particle that is non-finite or outside the world on a wall
+/// were built (m^2), and the first particle that is non-finite or outside the walls on a wall
 /// axis (~0 when none is).
 template <class Real>
 struct step_check {
@@ -73,13 +74,15 @@ struct check_particle {
     particle_view<Real> p;
     const vec4<Real>* x_at_build;
     world<Real> box;
+    wall_set<Real> walls;
 
     SPHERE_HD step_check<Real> operator()(std::size_t i) const
     {
         const vec3<Real> pos = p.x[i].xyz();
         bool bad = !isfinite(pos) || !isfinite(p.v_sync[i]) || !isfinite(p.omega_sync[i]);
         for (int a = 0; a < 3; ++a)
-            if (!box.periodic(a) && !(pos[a] >= box.lo[a] && pos[a] <= box.hi[a])) bad = true;
+            if (!box.periodic(a) && !(pos[a] >= walls.face[2 * a].position && pos[a] <= walls.face[2 * a + 1].position))
+                bad = true;
         const Real moved = norm2(box.nearest_image(pos - x_at_build[i].xyz()));
         return {bad ? Real(0) : moved, bad ? i : ~std::size_t(0)};
     }
