@@ -3,6 +3,9 @@
 /// The DEM half of sphere: `#include <sphere/dem.cuh>` brings in particles, the neighbour
 /// grid, contact laws, walls, integrators, the simulation template and its diagnostics.
 #include "analysis/energy.cuh"
+#include "analysis/porosity.cuh"
+#include "analysis/shear.cuh"
+#include "analysis/stress.cuh"
 #include "boundary/wall_control.cuh"
 #include "boundary/walls.cuh"
 #include "boundary/world.cuh"
@@ -26,6 +29,8 @@
 #include "integrate/integrate_particles.cuh"
 #include "integrate/integrators.cuh"
 #include "integrate/time_step.cuh"
+#include "particles/distributions.cuh"
+#include "particles/packing.cuh"
 #include "particles/particle.cuh"
 #include "particles/state.cuh"
 #include "particles/validate.cuh"

@@ -199,6 +199,17 @@ public:
         for_each_index(Policy{}, 1, detail::set_kinematics<Real>{particles_.view(), i, v, omega});
     }
 
+    /// Changes how wall face f moves from the next step on (e.g. from consolidation at a
+    /// stress to a fixed wall); validated like settings.walls.
+    void set_wall_control(int f, const wall_control<Real>& control)
+    {
+        if (f < 0 || f >= wall_set<Real>::count) detail::fail("set_wall_control: face ", f, " out of range [0, 6)");
+        wall_control<Real> controls[wall_set<Real>::count];
+        for (int k = 0; k < wall_set<Real>::count; ++k) controls[k] = k == f ? control : settings_.walls[k];
+        validate_wall_controls(controls, settings_.box);
+        settings_.walls[f] = control;
+    }
+
     std::size_t size() const { return particles_.size(); }
     Real dt() const { return dt_; }
     /// Simulated time (s), steps() * dt() in double.
@@ -223,7 +234,7 @@ public:
             detail::particle_energy<Real, Law>{self.particles_.view(), self.lists_.view(), settings_.box, walls_,
                                                settings_.contact, settings_.wall, settings_.gravity},
             energy_budget<Real>{}, plus_op{});
-        for (const wall_face<Real>& w : walls_.face) e.boundary_work += w.work;
+        for (const wall_face<Real>& w : walls_.face) e.boundary_work += Real(w.work);
         return e;
     }
 

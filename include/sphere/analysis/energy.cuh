@@ -78,7 +78,7 @@ struct particle_energy {
             const wall_face<Real>& wall = walls.face[f];
             if (!wall.active) continue;
             const int a = f / 2;
-            const Real delta_n = (xi.xyz()[a] - wall.position) * wall_set<Real>::inward_normal(f)[a] - xi.w;
+            const Real delta_n = (xi.xyz()[a] - Real(wall.position)) * wall_set<Real>::inward_normal(f)[a] - xi.w;
             if (delta_n < Real(0))
                 e.elastic += Law::wall_energy(wall_params, delta_n, c.wall_history[i * wall_set<Real>::count + f]);
         }

@@ -71,7 +71,7 @@ double wall_area(const wall_set<Real>& walls, const world<Real>& box, int f)
     for (int b = 0; b < 3; ++b) {
         if (b == f / 2) continue;
         area *= box.periodic(b) ? double(box.length(b))
-                                : double(walls.face[2 * b + 1].position) - double(walls.face[2 * b].position);
+                                : walls.face[2 * b + 1].position - walls.face[2 * b].position;
     }
     return area;
 }
@@ -90,9 +90,9 @@ void advance_walls(wall_set<Real>& walls, const wall_control<Real> (&controls)[w
         if (!w.active) continue;
         const int a = f / 2;
         const double inward = f % 2 == 0 ? 1.0 : -1.0; // inward normal along the axis
-        w.force = Real(particle_force[f]);
+        w.force = particle_force[f];
         const wall_control<Real>& c = controls[f];
-        double v_in = double(w.velocity) * inward;
+        double v_in = w.velocity * inward;
         if (c.mode == wall_mode::fixed) {
             v_in = 0;
         } else if (c.mode == wall_mode::velocity) {
@@ -104,10 +104,10 @@ void advance_walls(wall_set<Real>& walls, const wall_control<Real> (&controls)[w
         const double moved = v_in * inward * double(dt);
         // The power of this step's force at this step's time, with the wall's velocity there
         // taken as the mean of the velocities before and after (as the particles' v_sync).
-        const double v_sync = (double(w.velocity) + v_in * inward) / 2;
-        w.work = Real(double(w.work) - particle_force[f] * v_sync * double(dt));
-        w.velocity = Real(v_in * inward);
-        w.position = Real(double(w.position) + moved);
+        const double v_sync = (w.velocity + v_in * inward) / 2;
+        w.work -= particle_force[f] * v_sync * double(dt);
+        w.velocity = v_in * inward;
+        w.position += moved;
         if (!(w.position >= box.lo[a] && w.position <= box.hi[a]))
             detail::fail("step ", step, ": wall face ", f, " moved to ", w.position, " m, outside the world [",
                          box.lo[a], ", ", box.hi[a], "] m on axis ", a);

@@ -7,13 +7,15 @@
 namespace sphere {
 
 /// One face of the world box. Face f lies on axis f / 2, at the lower end when f is even.
+/// The wall's state is kept in double whatever the simulation's precision: a float position
+/// advanced by steps of ~1e-8 m would lose most of each step to rounding.
 template <class Real>
 struct wall_face {
-    bool active = false; ///< true on wall axes, false on periodic ones
-    Real position = 0;   ///< coordinate of the plane along its axis (m)
-    Real velocity = 0;   ///< velocity of the plane along its axis (m/s)
-    Real force = 0;      ///< force of the particles on the wall along its axis in the last step (N)
-    Real work = 0;       ///< work done by the wall on the particles so far (J)
+    bool active = false;  ///< true on wall axes, false on periodic ones
+    double position = 0;  ///< coordinate of the plane along its axis (m)
+    double velocity = 0;  ///< velocity of the plane along its axis (m/s)
+    double force = 0;     ///< force of the particles on the wall along its axis in the last step (N)
+    double work = 0;      ///< work done by the wall on the particles so far (J)
 };
 
 /// The six faces, copied into kernels by value.

@@ -71,14 +71,14 @@ struct interact {
             const std::size_t e = i * wall_set<Real>::count + static_cast<std::size_t>(f);
             const int a = f / 2;
             const vec3<Real> n = wall_set<Real>::inward_normal(f);
-            const Real dist = (xi.xyz()[a] - wall.position) * n[a];
+            const Real dist = (xi.xyz()[a] - Real(wall.position)) * n[a];
             const Real delta_n = dist - xi.w;
             vec4<Real> h = c.wall_history[e];
             Real on_axis = 0;
             if (delta_n < Real(0)) {
                 contact_motion<Real> m{n, delta_n, vi + dist * cross(n, wi), (p.v[i] + dist * cross(n, p.omega[i])) * dt};
-                m.velocity[a] -= wall.velocity;
-                m.step[a] -= wall.velocity * dt;
+                m.velocity[a] -= Real(wall.velocity);
+                m.step[a] -= Real(wall.velocity) * dt;
                 const contact_result<Real> r = Law::wall(wall_params, m, h, dt);
                 force += r.normal + r.tangential;
                 torque -= dist * cross(n, r.tangential);

@@ -81,7 +81,7 @@ struct check_particle {
         const vec3<Real> pos = p.x[i].xyz();
         bool bad = !isfinite(pos) || !isfinite(p.v_sync[i]) || !isfinite(p.omega_sync[i]);
         for (int a = 0; a < 3; ++a)
-            if (!box.periodic(a) && !(pos[a] >= walls.face[2 * a].position && pos[a] <= walls.face[2 * a + 1].position))
+            if (!box.periodic(a) && !(pos[a] >= Real(walls.face[2 * a].position) && pos[a] <= Real(walls.face[2 * a + 1].position)))
                 bad = true;
         const Real moved = norm2(box.nearest_image(pos - x_at_build[i].xyz()));
         return {bad ? Real(0) : moved, bad ? i : ~std::size_t(0)};

@@ -1,0 +1,507 @@
+#pragma once
+/// \file
+/// Versioned binary checkpoints (docs/io.md, "Checkpoints"): everything a simulation needs to
+/// continue, the settings with the time step actually used and every evolving field including
+/// the contact history and the walls. Little-endian, every floating value stored as a double
+/// (as sphere did), so a float run can continue a double one and vice versa. The file ends with
+/// an FNV-1a 64 checksum, is written atomically (io/atomic_file.cuh), and a missing, truncated,
+/// corrupt, wrong-version or inconsistent file is refused with a sphere::error naming the file
+/// and what is wrong. Host-only code.
+///
+/// Restarting from the same precision on the host backend with the same thread count continues
+/// bit-identically to the uninterrupted run:
+///
+///     sphere::write_checkpoint("run.ck", sim);
+///     ...
+///     auto sim2 = sphere::restart<sphere::simulation<double>>("run.ck");
+#include <cerrno>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
+#include <fstream>
+#include <ios>
+#include <iterator>
+#include <limits>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "../boundary/wall_control.cuh"
+#include "../boundary/walls.cuh"
+#include "../boundary/world.cuh"
+#include "../contact/params.cuh"
+#include "../core/constants.cuh"
+#include "../core/error.cuh"
+#include "../core/vec.cuh"
+#include "../particles/particle.cuh"
+#include "../particles/state.cuh"
+#include "../settings.cuh"
+#include "../simulation.cuh"
+#include "atomic_file.cuh"
+
+namespace sphere {
+
+/// The checkpoint format version this build writes, and the only one it reads.
+inline constexpr std::uint32_t checkpoint_format_version = 1;
+
+/// The first 8 bytes of every checkpoint.
+inline constexpr char checkpoint_magic[9] = "SPHERECK";
+
+/// The contents of a checkpoint, in the reader's precision.
+template <class Real>
+struct checkpoint_data {
+    settings<Real> config;             ///< the settings; config.dt is the time step the run used (s)
+    simulation_state<Real> state;      ///< every evolving field
+    std::uint32_t written_precision = 0; ///< sizeof the writer's Real: 4 (float) or 8 (double)
+
+    /// Particle descriptions from which a simulation with these settings is built before
+    /// restore(state): positions, radii, velocities and kinds of the state, densities from the
+    /// stored masses (mass / (4/3 pi r^3), in double).
+    std::vector<particle<Real>> particles() const
+    {
+        const particle_snapshot<Real>& s = state.particles;
+        std::vector<particle<Real>> out(s.size());
+        for (std::size_t i = 0; i < s.size(); ++i) {
+            const double r = double(s.x[i].w);
+            out[i].position = s.position(i);
+            out[i].radius = s.x[i].w;
+            out[i].density = Real(double(s.mass[i]) / (4.0 / 3.0 * pi<double> * r * r * r));
+            out[i].velocity = s.v[i];
+            out[i].angular_velocity = s.omega[i];
+            out[i].kind = static_cast<motion>(s.kind[i]);
+        }
+        return out;
+    }
+};
+
+namespace detail {
+
+/// Bytes before the payload: magic (8), version (u32), writer precision (u32), payload size (u64).
+inline constexpr std::size_t checkpoint_header_bytes = 24;
+/// Bytes after the payload: the checksum (u64).
+inline constexpr std::size_t checkpoint_checksum_bytes = 8;
+
+/// FNV-1a, 64 bit, of `size` bytes.
+inline std::uint64_t fnv1a64(const char* data, std::size_t size)
+{
+    std::uint64_t h = 14695981039346656037ull;
+    for (std::size_t k = 0; k < size; ++k) {
+        h ^= static_cast<unsigned char>(data[k]);
+        h *= 1099511628211ull;
+    }
+    return h;
+}
+
+/// Appends little-endian values to a byte string.
+class checkpoint_encoder {
+public:
+    std::string bytes;
+
+    void u8(std::uint8_t v) { bytes += static_cast<char>(v); }
+    void u32(std::uint32_t v)
+    {
+        char b[4];
+        for (int k = 0; k < 4; ++k) b[k] = static_cast<char>((v >> (8 * k)) & 0xffu);
+        bytes.append(b, 4);
+    }
+    void u64(std::uint64_t v)
+    {
+        char b[8];
+        for (int k = 0; k < 8; ++k) b[k] = static_cast<char>((v >> (8 * k)) & 0xffu);
+        bytes.append(b, 8);
+    }
+    void f64(double d)
+    {
+        std::uint64_t v;
+        std::memcpy(&v, &d, sizeof v);
+        u64(v);
+    }
+    template <class Real>
+    void v3(const vec3<Real>& a)
+    {
+        f64(double(a.x));
+        f64(double(a.y));
+        f64(double(a.z));
+    }
+    template <class Real>
+    void v4(const vec4<Real>& a)
+    {
+        f64(double(a.x));
+        f64(double(a.y));
+        f64(double(a.z));
+        f64(double(a.w));
+    }
+    template <class Real>
+    void params(const contact_params<Real>& p)
+    {
+        f64(double(p.k_n));
+        f64(double(p.k_t));
+        f64(double(p.gamma_n));
+        f64(double(p.gamma_t));
+        f64(double(p.mu_s));
+        f64(double(p.mu_d));
+        u32(p.tension ? 1u : 0u);
+    }
+    /// An array: its element count (u64), then each element through `put`.
+    template <class T, class Put>
+    void array(const std::vector<T>& values, Put put)
+    {
+        u64(values.size());
+        for (const T& v : values) put(*this, v);
+    }
+};
+
+/// Reads little-endian values from a checksummed payload; a read past its end or a value out
+/// of range means the contents do not fit together: a sphere::error naming the file.
+class checkpoint_decoder {
+public:
+    checkpoint_decoder(const std::string& bytes, std::size_t begin, std::size_t end, const std::string& path)
+        : bytes_(bytes), at_(begin), end_(end), path_(path)
+    {
+    }
+
+    template <class... Parts>
+    [[noreturn]] void inconsistent(const Parts&... parts) const
+    {
+        fail("checkpoint '", path_, "': inconsistent contents: ", parts...);
+    }
+
+    std::uint8_t u8(const char* what)
+    {
+        need(1, what);
+        return static_cast<std::uint8_t>(bytes_[at_++]);
+    }
+    std::uint32_t u32(const char* what)
+    {
+        need(4, what);
+        std::uint32_t v = 0;
+        for (int k = 0; k < 4; ++k) v |= std::uint32_t(static_cast<unsigned char>(bytes_[at_ + k])) << (8 * k);
+        at_ += 4;
+        return v;
+    }
+    std::uint64_t u64(const char* what)
+    {
+        need(8, what);
+        std::uint64_t v = 0;
+        for (int k = 0; k < 8; ++k) v |= std::uint64_t(static_cast<unsigned char>(bytes_[at_ + k])) << (8 * k);
+        at_ += 8;
+        return v;
+    }
+    double f64(const char* what)
+    {
+        const std::uint64_t v = u64(what);
+        double d;
+        std::memcpy(&d, &v, sizeof d);
+        return d;
+    }
+    /// A u32 that must be at most `max` (an enumeration or a flag).
+    std::uint32_t choice(const char* what, std::uint32_t max)
+    {
+        const std::uint32_t v = u32(what);
+        if (v > max) inconsistent(what, " = ", v, ", at most ", max, " is valid");
+        return v;
+    }
+    template <class Real>
+    vec3<Real> v3(const char* what)
+    {
+        const double x = f64(what), y = f64(what), z = f64(what);
+        return {Real(x), Real(y), Real(z)};
+    }
+    template <class Real>
+    vec4<Real> v4(const char* what)
+    {
+        const double x = f64(what), y = f64(what), z = f64(what), w = f64(what);
+        return {Real(x), Real(y), Real(z), Real(w)};
+    }
+    template <class Real>
+    contact_params<Real> params(const char* what)
+    {
+        contact_params<Real> p;
+        p.k_n = Real(f64(what));
+        p.k_t = Real(f64(what));
+        p.gamma_n = Real(f64(what));
+        p.gamma_t = Real(f64(what));
+        p.mu_s = Real(f64(what));
+        p.mu_d = Real(f64(what));
+        p.tension = choice(what, 1) == 1;
+        return p;
+    }
+    /// An array of `expected` elements of `element_bytes` bytes each, read by `get`.
+    template <class T, class Get>
+    std::vector<T> array(const char* what, std::uint64_t expected, std::size_t element_bytes, Get get)
+    {
+        const std::uint64_t n = u64(what);
+        if (n != expected) inconsistent(what, ": ", n, " entries, expected ", expected);
+        if (n > (end_ - at_) / element_bytes)
+            inconsistent(what, ": ", n, " entries of ", element_bytes, " bytes do not fit in the ", end_ - at_,
+                         " bytes left");
+        std::vector<T> out(static_cast<std::size_t>(n));
+        for (T& v : out) v = get(*this);
+        return out;
+    }
+
+    std::size_t left() const { return end_ - at_; }
+
+private:
+    void need(std::size_t k, const char* what) const
+    {
+        if (end_ - at_ < k) inconsistent("the payload ends before ", what);
+    }
+
+    const std::string& bytes_;
+    std::size_t at_, end_;
+    const std::string& path_;
+};
+
+} // namespace detail
+
+/// The bytes of a checkpoint (the layout of docs/io.md) for settings `config`, the time step
+/// `dt` (s) the run uses (stored in place of config.dt) and a state.
+template <class Real>
+std::string encode_checkpoint(const settings<Real>& config, Real dt, const simulation_state<Real>& s)
+{
+    using detail::checkpoint_encoder;
+    const std::size_t n = s.particles.size();
+    checkpoint_encoder e;
+    e.bytes.reserve(detail::checkpoint_header_bytes + 1024 + n * (32 * 8 + 1 + 4 + 32 + 6 * 32) +
+                    s.partners.size() * (4 + 32) + detail::checkpoint_checksum_bytes);
+    e.bytes.append(checkpoint_magic, 8);
+    e.u32(checkpoint_format_version);
+    e.u32(static_cast<std::uint32_t>(sizeof(Real)));
+    e.u64(0); // payload size, patched below
+
+    // Settings.
+    e.v3(config.box.lo);
+    e.v3(config.box.hi);
+    for (int a = 0; a < 3; ++a) e.u32(static_cast<std::uint32_t>(config.box.axis[a]));
+    e.params(config.contact);
+    e.params(config.wall);
+    e.v3(config.gravity);
+    e.f64(double(dt));
+    e.f64(double(config.skin));
+    e.u64(config.contact_capacity);
+    e.f64(double(config.cell_size));
+    for (const wall_control<Real>& c : config.walls) {
+        e.u32(static_cast<std::uint32_t>(c.mode));
+        e.f64(double(c.velocity));
+        e.f64(double(c.stress));
+        e.f64(double(c.amplitude));
+        e.f64(double(c.frequency));
+        e.f64(double(c.phase));
+        e.f64(double(c.mass));
+    }
+
+    // State.
+    e.u64(n);
+    e.u64(s.steps);
+    e.u64(s.rebuilds);
+    e.u32(s.needs_rebuild ? 1u : 0u);
+    for (const wall_face<Real>& w : s.walls.face) {
+        e.u32(w.active ? 1u : 0u);
+        e.f64(double(w.position));
+        e.f64(double(w.velocity));
+        e.f64(double(w.force));
+        e.f64(double(w.work));
+    }
+    const auto put_v4 = [](checkpoint_encoder& out, const vec4<Real>& v) { out.v4(v); };
+    const auto put_v3 = [](checkpoint_encoder& out, const vec3<Real>& v) { out.v3(v); };
+    const auto put_real = [](checkpoint_encoder& out, Real v) { out.f64(double(v)); };
+    const auto put_u32 = [](checkpoint_encoder& out, unsigned v) { out.u32(v); };
+    const particle_snapshot<Real>& p = s.particles;
+    e.array(p.x, put_v4);
+    for (const auto* field : {&p.v, &p.omega, &p.v_sync, &p.omega_sync, &p.angpos, &p.force, &p.torque})
+        e.array(*field, put_v3);
+    for (const auto* field : {&p.mass, &p.pressure, &p.e_visc, &p.e_fric, &p.p_visc, &p.p_fric})
+        e.array(*field, put_real);
+    e.array(p.kind, [](checkpoint_encoder& out, std::uint8_t v) { out.u8(v); });
+    e.array(s.counts, put_u32);
+    e.array(s.partners, put_u32);
+    e.array(s.histories, put_v4);
+    e.array(s.wall_histories, put_v4);
+    e.array(s.x_at_build, put_v4);
+
+    const std::uint64_t payload = e.bytes.size() - detail::checkpoint_header_bytes;
+    for (int k = 0; k < 8; ++k) e.bytes[16 + k] = static_cast<char>((payload >> (8 * k)) & 0xffu);
+    e.u64(detail::fnv1a64(e.bytes.data(), e.bytes.size()));
+    return e.bytes;
+}
+
+/// Decodes the bytes of a checkpoint into the precision Real; `path` names the file in
+/// errors. Throws sphere::error (message `checkpoint '<path>': ...`, see docs/io.md) when the
+/// bytes are not a checkpoint, have another format version, are truncated or longer than the
+/// header says, fail the checksum, or hold contents that do not fit together.
+template <class Real>
+checkpoint_data<Real> decode_checkpoint(const std::string& bytes, const std::string& path)
+{
+    using detail::checkpoint_decoder;
+    constexpr std::size_t header = detail::checkpoint_header_bytes, tail = detail::checkpoint_checksum_bytes;
+    const std::size_t size = bytes.size();
+    const std::size_t magic_seen = size < 8 ? size : 8;
+    if (bytes.compare(0, magic_seen, checkpoint_magic, magic_seen) != 0)
+        detail::fail("checkpoint '", path, "': not a sphere checkpoint: the file does not start with \"",
+                     checkpoint_magic, "\"");
+    if (size < header + tail)
+        detail::fail("checkpoint '", path, "': truncated: the file has ", size, " bytes, fewer than the ",
+                     header + tail, " of a header and checksum");
+    checkpoint_decoder head(bytes, 8, header, path);
+    const std::uint32_t version = head.u32("the format version");
+    if (version != checkpoint_format_version)
+        detail::fail("checkpoint '", path, "': format version ", version, ", but this build reads version ",
+                     checkpoint_format_version, " only");
+    const std::uint32_t precision = head.u32("the writer's precision");
+    const std::uint64_t payload = head.u64("the payload size");
+    if (payload > std::numeric_limits<std::uint64_t>::max() - header - tail)
+        detail::fail("checkpoint '", path, "': corrupt: the header gives an impossible payload size of ", payload,
+                     " bytes");
+    const std::uint64_t expected = header + payload + tail;
+    if (size < expected)
+        detail::fail("checkpoint '", path, "': truncated: the file has ", size, " bytes, a complete checkpoint has ",
+                     expected);
+    if (size > expected)
+        detail::fail("checkpoint '", path, "': corrupt: the file has ", size, " bytes, a complete checkpoint has ",
+                     expected, " (trailing data)");
+    std::uint64_t stored = 0;
+    for (int k = 0; k < 8; ++k)
+        stored |= std::uint64_t(static_cast<unsigned char>(bytes[size - tail + k])) << (8 * k);
+    const std::uint64_t computed = detail::fnv1a64(bytes.data(), size - tail);
+    if (stored != computed) {
+        std::ostringstream hex;
+        hex << std::hex << "stored 0x" << stored << ", computed 0x" << computed;
+        detail::fail("checkpoint '", path, "': corrupt: checksum mismatch (", hex.str(), ")");
+    }
+    checkpoint_decoder d(bytes, header, size - tail, path);
+    if (precision != 4 && precision != 8)
+        d.inconsistent("the writer's precision is ", precision, " bytes, neither 4 (float) nor 8 (double)");
+
+    checkpoint_data<Real> c;
+    c.written_precision = precision;
+    settings<Real>& s = c.config;
+    s.box.lo = d.v3<Real>("settings.box.lo");
+    s.box.hi = d.v3<Real>("settings.box.hi");
+    for (int a = 0; a < 3; ++a) s.box.axis[a] = static_cast<boundary>(d.choice("settings.box.axis", 1));
+    s.contact = d.params<Real>("settings.contact");
+    s.wall = d.params<Real>("settings.wall");
+    s.gravity = d.v3<Real>("settings.gravity");
+    s.dt = Real(d.f64("the time step"));
+    s.skin = Real(d.f64("settings.skin"));
+    const std::uint64_t capacity = d.u64("settings.contact_capacity");
+    if (capacity < 1 || capacity > std::numeric_limits<unsigned>::max())
+        d.inconsistent("settings.contact_capacity = ", capacity, " is out of range");
+    s.contact_capacity = static_cast<std::size_t>(capacity);
+    s.cell_size = Real(d.f64("settings.cell_size"));
+    for (wall_control<Real>& w : s.walls) {
+        w.mode = static_cast<wall_mode>(d.choice("settings.walls[].mode", 2));
+        w.velocity = Real(d.f64("settings.walls[].velocity"));
+        w.stress = Real(d.f64("settings.walls[].stress"));
+        w.amplitude = Real(d.f64("settings.walls[].amplitude"));
+        w.frequency = Real(d.f64("settings.walls[].frequency"));
+        w.phase = Real(d.f64("settings.walls[].phase"));
+        w.mass = Real(d.f64("settings.walls[].mass"));
+    }
+
+    simulation_state<Real>& st = c.state;
+    const std::uint64_t n = d.u64("the particle count");
+    if (n < 1 || n >= std::numeric_limits<unsigned>::max())
+        d.inconsistent("the particle count ", n, " is out of range (1 to 2^32 - 2)");
+    if (capacity > std::numeric_limits<std::uint64_t>::max() / n)
+        d.inconsistent(n, " particles times a capacity of ", capacity, " overflows");
+    st.steps = static_cast<std::size_t>(d.u64("the step count"));
+    st.rebuilds = static_cast<std::size_t>(d.u64("the rebuild count"));
+    st.needs_rebuild = d.choice("the rebuild flag", 1) == 1;
+    for (int f = 0; f < wall_set<Real>::count; ++f) {
+        wall_face<Real>& w = st.walls.face[f];
+        w.active = d.choice("a wall's active flag", 1) == 1;
+        // Converted to the type wall_face keeps its state in.
+        w.position = static_cast<decltype(w.position)>(d.f64("a wall position"));
+        w.velocity = static_cast<decltype(w.velocity)>(d.f64("a wall velocity"));
+        w.force = static_cast<decltype(w.force)>(d.f64("a wall force"));
+        w.work = static_cast<decltype(w.work)>(d.f64("a wall's work"));
+        if (w.active == s.box.periodic(f / 2))
+            d.inconsistent("wall face ", f, " is ", w.active ? "active" : "inactive", " but axis ", f / 2, " is ",
+                           s.box.periodic(f / 2) ? "periodic" : "closed by walls");
+    }
+    const auto get_v4 = [](checkpoint_decoder& in) { return in.v4<Real>("a 4-vector"); };
+    const auto get_v3 = [](checkpoint_decoder& in) { return in.v3<Real>("a 3-vector"); };
+    const auto get_real = [](checkpoint_decoder& in) { return Real(in.f64("a particle value")); };
+    const auto get_u32 = [](checkpoint_decoder& in) { return static_cast<unsigned>(in.u32("a contact entry")); };
+    particle_snapshot<Real>& p = st.particles;
+    p.x = d.array<vec4<Real>>("the positions", n, 32, get_v4);
+    const char* vector_names[7] = {"the velocities",      "the angular velocities", "the synchronous velocities",
+                                   "the synchronous angular velocities", "the angular positions", "the forces",
+                                   "the torques"};
+    std::vector<vec3<Real>>* vectors[7] = {&p.v, &p.omega, &p.v_sync, &p.omega_sync, &p.angpos, &p.force, &p.torque};
+    for (int k = 0; k < 7; ++k) *vectors[k] = d.array<vec3<Real>>(vector_names[k], n, 24, get_v3);
+    const char* scalar_names[6] = {"the masses", "the pressures", "the viscous dissipation",
+                                   "the frictional dissipation", "the viscous power", "the frictional power"};
+    std::vector<Real>* scalars[6] = {&p.mass, &p.pressure, &p.e_visc, &p.e_fric, &p.p_visc, &p.p_fric};
+    for (int k = 0; k < 6; ++k) *scalars[k] = d.array<Real>(scalar_names[k], n, 8, get_real);
+    p.kind = d.array<std::uint8_t>("the motion kinds", n, 1,
+                                   [](checkpoint_decoder& in) { return in.u8("a motion kind"); });
+    for (std::size_t i = 0; i < p.kind.size(); ++i)
+        if (p.kind[i] > 2) d.inconsistent("particle ", i, " has motion kind ", unsigned(p.kind[i]), ", at most 2 is valid");
+    st.counts = d.array<unsigned>("the contact counts", n, 4, get_u32);
+    st.partners = d.array<unsigned>("the contact partners", n * capacity, 4, get_u32);
+    st.histories = d.array<vec4<Real>>("the contact histories", n * capacity, 32, get_v4);
+    st.wall_histories = d.array<vec4<Real>>("the wall histories", n * wall_set<Real>::count, 32, get_v4);
+    st.x_at_build = d.array<vec4<Real>>("the positions at the last rebuild", n, 32, get_v4);
+    if (d.left() != 0) d.inconsistent(d.left(), " bytes follow the last array");
+    for (std::size_t i = 0; i < st.counts.size(); ++i) {
+        if (st.counts[i] > capacity)
+            d.inconsistent("particle ", i, " lists ", st.counts[i], " partners, more than the capacity ", capacity);
+        for (unsigned k = 0; k < st.counts[i]; ++k) {
+            const unsigned j = st.partners[i * capacity + k];
+            if (j >= n || j == i)
+                d.inconsistent("particle ", i, " lists partner ", j, " (", n, " particles)");
+        }
+    }
+    return c;
+}
+
+/// Writes a checkpoint of settings `config`, time step `dt` (s) and a state to `path`
+/// atomically; throws sphere::error naming the file when it cannot be written.
+template <class Real>
+void write_checkpoint(const std::string& path, const settings<Real>& config, Real dt, const simulation_state<Real>& state)
+{
+    write_file_atomically(path, encode_checkpoint(config, dt, state));
+}
+
+/// Writes a checkpoint of a simulation (its settings, time step and state) to `path`
+/// atomically; throws sphere::error naming the file when it cannot be written.
+template <class Sim>
+void write_checkpoint(const std::string& path, const Sim& sim)
+{
+    write_checkpoint(path, sim.config(), sim.dt(), sim.state());
+}
+
+/// Reads a checkpoint into the precision Real (values converted when the writer used the
+/// other one). Throws sphere::error `checkpoint '<path>': ...` when the file cannot be opened or
+/// read, or for any of the reasons of decode_checkpoint.
+template <class Real>
+checkpoint_data<Real> read_checkpoint(const std::string& path)
+{
+    std::ifstream in(path, std::ios::binary);
+    if (!in) {
+        const int code = errno;
+        detail::fail("checkpoint '", path, "': cannot open: ", std::strerror(code));
+    }
+    std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    if (in.bad()) detail::fail("checkpoint '", path, "': cannot read the file");
+    return decode_checkpoint<Real>(bytes, path);
+}
+
+/// A simulation of type Sim (e.g. sphere::simulation<float>) continuing from the checkpoint
+/// at `path`: built from its settings and particles, then restored to its state. Observers
+/// are not part of a checkpoint; add them again. Throws sphere::error for an unreadable
+/// checkpoint (read_checkpoint) or settings the simulation refuses.
+template <class Sim>
+Sim restart(const std::string& path)
+{
+    using Real = typename Sim::real_type;
+    const checkpoint_data<Real> c = read_checkpoint<Real>(path);
+    Sim sim(c.config, c.particles());
+    sim.restore(c.state);
+    return sim;
+}
+
+} // namespace sphere
