@@ -184,16 +184,15 @@ double solid_volume(const std::vector<vec4<Real>>& x, const world<Real>& box, co
     bool whole[3];
     for (int a = 0; a < 3; ++a)
         whole[a] = box.periodic(a) && lo[a] == double(box.lo[a]) && hi[a] == double(box.hi[a]);
-    const vec3<double> inf{HUGE_VAL, HUGE_VAL, HUGE_VAL};
+    vec3<double> from = lo, to = hi;
+    for (int a = 0; a < 3; ++a)
+        if (whole[a]) { // on this axis the particle and its images fill exactly one sphere's volume
+            from[a] = -HUGE_VAL;
+            to[a] = HUGE_VAL;
+        }
     double v = 0;
     for (const vec4<Real>& p : x) {
         const double r = double(p.w);
-        vec3<double> from = lo, to = hi;
-        for (int a = 0; a < 3; ++a)
-            if (whole[a]) { // the particle and its images fill exactly one sphere's volume
-                from[a] = -inf[a];
-                to[a] = inf[a];
-            }
         // Images one period either way on periodic axes that the region does not span.
         for (int iz = -1; iz <= 1; ++iz)
             for (int iy = -1; iy <= 1; ++iy)

@@ -154,6 +154,7 @@ public:
     double velocity() const { return velocity_; }
     /// Shear strain rate at the last update, velocity() / height() (1/s).
     double strain_rate() const { return velocity_ / height_; }
+    /// The layers it follows.
     const shear_layers& layers() const { return layers_; }
 
 private:

@@ -46,10 +46,11 @@ struct contact_snapshot {
     std::vector<unsigned> partners;   ///< partner of entry k of particle i at [i * capacity + k]
     std::vector<vec4<Real>> forces;   ///< per entry: tangential force on i (N) in xyz, f_n . n (N) in w
     std::vector<Real> wall_forces;    ///< force of face f on particle i along its axis (N), [i * 6 + f]
-    std::size_t capacity = 0;
-    world<Real> box;
-    wall_set<Real> walls;
+    std::size_t capacity = 0;         ///< entries per particle
+    world<Real> box;                  ///< the world (periodic axes for nearest images)
+    wall_set<Real> walls;             ///< the walls, with their positions
 
+    /// Number of particles.
     std::size_t size() const { return x.size(); }
     /// Entries of particle i that are listed (count clamped to the capacity).
     unsigned listed(std::size_t i) const { return counts[i] < capacity ? counts[i] : static_cast<unsigned>(capacity); }
@@ -81,7 +82,8 @@ contact_snapshot<Real> take_contact_snapshot(const simulation<Real, Policy, Law,
 
 /// A 3x3 tensor (Pa), s[i][j].
 struct stress_tensor {
-    double s[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
+    double s[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}}; ///< components (Pa), row i, column j
+    /// Component ij (Pa).
     double operator()(int i, int j) const { return s[i][j]; }
     /// Mean normal stress, trace / 3 (Pa).
     double mean() const { return (s[0][0] + s[1][1] + s[2][2]) / 3; }

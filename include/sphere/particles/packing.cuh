@@ -265,17 +265,32 @@ grid_geometry<Real> fit_world(settings<Real>& s, const std::vector<particle<Real
             hi[a] = std::max(hi[a], double(p.position[a]) + double(p.radius));
         }
     }
-    const double cell = 2 * r_max + double(s.skin);
+    // The cell width as the simulation computes it (in Real), so that the box holds exactly
+    // the whole number of cells chosen here.
+    const Real reach = Real(2) * static_cast<Real>(r_max) + s.skin;
+    const double cell = double(reach);
+    std::size_t cells[3] = {0, 0, 0};
     for (int a = 0; a < 3; ++a) {
         if (s.box.periodic(a)) continue;
         const double from = lo[a] - double(margin) * r_max;
-        double to = hi[a] + double(margin) * r_max + (a == 2 ? double(headroom) : 0.0);
-        to = from + std::ceil((to - from) / cell * (1 - 1e-12)) * cell;
+        const double to = hi[a] + double(margin) * r_max + (a == 2 ? double(headroom) : 0.0);
+        cells[a] = static_cast<std::size_t>(std::ceil((to - from) / cell * (1 - 1e-12)));
         s.box.lo[a] = static_cast<Real>(from);
-        s.box.hi[a] = static_cast<Real>(to);
+        s.box.hi[a] = static_cast<Real>(from + double(cells[a]) * cell);
     }
     s.cell_size = 0;
-    return grid_geometry<Real>::make(s.box, static_cast<Real>(cell), Real(0));
+    grid_geometry<Real> g = grid_geometry<Real>::make(s.box, reach, Real(0));
+    for (int tries = 0; tries < 64; ++tries) { // round-off may leave a hair less than the last cell
+        bool short_of = false;
+        for (int a = 0; a < 3; ++a)
+            if (!s.box.periodic(a) && g.n[a] < cells[a]) {
+                s.box.hi[a] = std::nextafter(s.box.hi[a], Real(HUGE_VAL));
+                short_of = true;
+            }
+        if (!short_of) break;
+        g = grid_geometry<Real>::make(s.box, reach, Real(0));
+    }
+    return g;
 }
 
 /// Outcome of deposit().
