@@ -8,6 +8,8 @@
 #include <sphere/dem.cuh>
 #include <sphere/io.cuh>
 
+#include "support.hpp"
+
 #include <cstddef>
 #include <cstdint>
 #include <exception>
@@ -28,17 +30,9 @@ constexpr std::size_t every = 25, steps = 100;
 template <class Real>
 sphere::simulation<Real> make_simulation()
 {
-    sphere::settings<Real> s;
-    s.box.lo = {Real(-0.05), Real(-0.05), Real(-0.05)};
-    s.box.hi = {Real(0.05), Real(0.05), Real(0.04)};
-    s.contact.k_n = Real(1e5);
-    s.contact.k_t = Real(1e5 * 2.0 / 7.0);
-    s.contact.gamma_n = Real(5);
-    s.contact.gamma_t = Real(2);
-    s.contact.mu_s = Real(0.5);
-    s.contact.mu_d = Real(0.4);
+    sphere::settings<Real> s = sphere_test::frictional_box<Real>(0.05);
+    s.box.hi.z = Real(0.04);
     s.wall = s.contact;
-    s.gravity = {Real(0), Real(0), Real(-9.81)};
     s.skin = Real(0.002);
     std::vector<sphere::particle<Real>> ps;
     for (int k = 0; k < 3; ++k)
