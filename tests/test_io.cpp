@@ -110,6 +110,7 @@ void require_identical(const sphere::simulation_state<Real>& a, const sphere::si
     CHECK(same_bits(a.histories, b.histories));
     CHECK(same_bits(a.wall_histories, b.wall_histories));
     CHECK(same_bits(a.x_at_build, b.x_at_build));
+    CHECK(same_bits(a.drive_work, b.drive_work));
     for (int f = 0; f < 6; ++f) {
         INFO("wall face " << f);
         CHECK(a.walls.face[f].active == b.walls.face[f].active);
@@ -164,6 +165,8 @@ std::vector<sphere::particle<Real>> eventful_particles()
     ps[0].kind = sphere::motion::fixed;
     ps[1].kind = sphere::motion::prescribed;
     ps[1].velocity = {Real(0.05), Real(0), Real(0)};
+    ps[2].kind = sphere::motion::prescribed_horizontal;
+    ps[2].velocity = {Real(-0.05), Real(0.02), Real(0)};
     return ps;
 }
 
@@ -238,6 +241,7 @@ TEMPLATE_TEST_CASE("checkpoint restart continues bit-identically", "[io][checkpo
     CHECK(double(original.walls().face[5].position) < 0.0395);
     CHECK(double(original.walls().face[5].force) > 0);
     CHECK(double(at_checkpoint.walls.face[5].velocity) != 0);
+    CHECK(at_checkpoint.drive_work != 0); // the driven particles had pushed others
 }
 
 TEMPLATE_TEST_CASE("checkpoints convert between float and double", "[io][checkpoint]", float, double)
@@ -414,10 +418,10 @@ TEMPLATE_TEST_CASE("broken checkpoints raise the documented errors", "[io][check
         };
         const std::uint64_t n = 64, cap = sim.config().contact_capacity;
         CHECK(bytes.compare(0, 8, "SPHERECK") == 0);
-        CHECK(u32_at(8) == 1);
+        CHECK(u32_at(8) == 2);
         CHECK(u32_at(12) == sizeof(Real));
         CHECK(u64_at(16) == size - 32);
-        CHECK(size == 968 + 477 * n + 36 * n * cap);
+        CHECK(size == 976 + 477 * n + 36 * n * cap);
         CHECK(f64_at(24 + 40) == double(sim.config().box.hi.z)); // box.hi = payload bytes 24-47
         CHECK(u32_at(24 + 48) == 0); // box.axis[0]: wall
         CHECK(f64_at(24 + 60) == double(sim.config().contact.k_n));
@@ -433,8 +437,9 @@ TEMPLATE_TEST_CASE("broken checkpoints raise the documented errors", "[io][check
         CHECK(u64_at(24 + 548) == sim.rebuilds());
         CHECK(u32_at(24 + 560 + 5 * 36) == 1); // face 5 active
         CHECK(f64_at(24 + 560 + 5 * 36 + 4) == double(sim.walls().face[5].position));
-        CHECK(u64_at(24 + 776) == n); // the positions' count
-        CHECK(f64_at(24 + 776 + 8 + 3 * 8) == double(sim.snapshot().x[0].w)); // particle 0's radius
+        CHECK(f64_at(24 + 776) == sim.drive_work());
+        CHECK(u64_at(24 + 784) == n); // the positions' count
+        CHECK(f64_at(24 + 784 + 8 + 3 * 8) == double(sim.snapshot().x[0].w)); // particle 0's radius
     }
     SECTION("missing")
     {
@@ -489,11 +494,11 @@ TEMPLATE_TEST_CASE("broken checkpoints raise the documented errors", "[io][check
     SECTION("wrong version")
     {
         std::string b = bytes;
-        REQUIRE(b[8] == 1); // the version, little-endian u32 at byte 8
-        b[8] = 2;
+        REQUIRE(b[8] == 2); // the version, little-endian u32 at byte 8
+        b[8] = 1;
         write_bytes(bad, b);
         REQUIRE_THROWS_WITH(sphere::read_checkpoint<Real>(bad),
-                            where + "format version 2, but this build reads version 1 only");
+                            where + "format version 1, but this build reads version 2 only");
     }
     SECTION("sizes that do not fit the particle count")
     {

@@ -228,3 +228,33 @@ TEMPLATE_TEST_CASE("bad wall controls are refused with the face named", "[walls]
         REQUIRE_THROWS_WITH(sim.set_wall_control(6, c), Catch::Contains("set_wall_control: face 6 out of range"));
     }
 }
+
+TEMPLATE_TEST_CASE("set_wall_position moves a wall onto the sample and refuses impossible places", "[walls][errors]",
+                   float, double)
+{
+    using Real = TestType;
+    auto [s, p] = d10_column<Real>(0);
+    const double R = set_p<Real>::radius, top = 20 * R; // highest particle point
+    s.box.hi.z = Real(0.5);                          // plenty of headroom above the column
+    s.walls[5].mode = sphere::wall_mode::velocity;
+    s.walls[5].velocity = Real(0.01);
+    sphere::simulation<Real> sim(s, p);
+    // Wall faces 0-3 lie on periodic axes.
+    CHECK_THROWS_WITH(sim.set_wall_position(0, 0.01), Catch::Contains("axis 0 is periodic, so face 0 has no wall"));
+    CHECK_THROWS_WITH(sim.set_wall_position(6, 0.01), Catch::Contains("face 6 out of range"));
+    CHECK_THROWS_WITH(sim.set_wall_position(5, 0.625), Catch::Contains("face 5 at 0.625 m lies outside the world"));
+    CHECK_THROWS_WITH(sim.set_wall_position(5, -0.1), Catch::Contains("lies outside the world"));
+    CHECK_THROWS_WITH(sim.set_wall_position(4, 0.5), Catch::Contains("would cross the opposite wall at 0.5 m"));
+    CHECK_THROWS_WITH(sim.set_wall_position(5, 18 * R), Catch::Contains("would lie outside face 5"));
+    CHECK(sim.walls().face[5].position == 0.5); // nothing changed by the refused calls
+    // 1 mm above the column: the velocity-controlled wall then reaches the top layer after
+    // 0.1 s and compresses it; before that the column feels nothing.
+    sim.set_wall_position(5, top + 0.001);
+    CHECK(sim.walls().face[5].position == top + 0.001);
+    CHECK(sim.walls().face[5].velocity == 0);
+    sim.run(std::size_t(0.09 / double(sim.dt())));
+    CHECK(sim.walls().face[5].force == 0);
+    CHECK(sim.walls().face[5].position == Approx(top + 0.001 - 0.01 * sim.time()).margin(1e-9));
+    sim.run(std::size_t(0.02 / double(sim.dt())));
+    CHECK(sim.walls().face[5].force > 0);
+}

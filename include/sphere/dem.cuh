@@ -30,6 +30,7 @@
 #include "integrate/integrators.cuh"
 #include "integrate/time_step.cuh"
 #include "particles/distributions.cuh"
+#include "particles/layers.cuh"
 #include "particles/packing.cuh"
 #include "particles/particle.cuh"
 #include "particles/state.cuh"

@@ -35,24 +35,42 @@ struct copy_positions {
     SPHERE_HD void operator()(std::size_t i) const { to[i] = from[i]; }
 };
 
-/// Forces of the particles on the six walls along their axes (N), summed in double.
-struct wall_forces {
-    double f[6];
-    SPHERE_HD wall_forces operator+(const wall_forces& b) const
+/// What the particles do to the boundaries in one step: their forces on the six walls along
+/// the axes (N) and the power of the agent that drives the prescribed particles (W), both
+/// summed in double.
+struct boundary_loads {
+    double wall_force[6];
+    double drive_power;
+    SPHERE_HD boundary_loads operator+(const boundary_loads& b) const
     {
-        wall_forces out;
-        for (int k = 0; k < 6; ++k) out.f[k] = f[k] + b.f[k];
+        boundary_loads out;
+        for (int k = 0; k < 6; ++k) out.wall_force[k] = wall_force[k] + b.wall_force[k];
+        out.drive_power = drive_power + b.drive_power;
         return out;
     }
 };
 
+/// Particle i's share of the boundary loads, after integration. The agent that keeps a
+/// prescribed particle on its course cancels whatever the contacts and gravity would change:
+/// its force is m a - f - m g and its torque -t (a = 0 for motion::prescribed, a = f_z / m
+/// along z for motion::prescribed_horizontal), and its power is their product with the
+/// velocities at the positions' time (docs/physics.md, "Driven particles").
 template <class Real>
-struct particle_wall_forces {
+struct particle_boundary_loads {
+    particle_view<Real> p;
     const Real* wall_force; ///< force of face f on particle i along the axis, at [i * 6 + f]
-    SPHERE_HD wall_forces operator()(std::size_t i) const
+    vec3<Real> gravity;
+    SPHERE_HD boundary_loads operator()(std::size_t i) const
     {
-        wall_forces out;
-        for (int k = 0; k < 6; ++k) out.f[k] = -double(wall_force[i * 6 + k]);
+        boundary_loads out;
+        for (int k = 0; k < 6; ++k) out.wall_force[k] = -double(wall_force[i * 6 + k]);
+        out.drive_power = 0;
+        const auto kind = static_cast<motion>(p.kind[i]);
+        if (kind == motion::prescribed || kind == motion::prescribed_horizontal) {
+            vec3<Real> agent = -(p.force[i] + gravity * p.mass[i]);
+            if (kind == motion::prescribed_horizontal) agent.z = -gravity.z * p.mass[i];
+            out.drive_power = double(dot(agent, p.v_sync[i])) - double(dot(p.torque[i], p.omega_sync[i]));
+        }
         return out;
     }
 };
@@ -80,6 +98,7 @@ struct simulation_state {
     std::vector<vec4<Real>> histories, wall_histories; ///< their history entries
     std::vector<vec4<Real>> x_at_build;               ///< positions when the lists were built
     wall_set<Real> walls;
+    double drive_work = 0; ///< work done on the prescribed particles so far (J)
     std::size_t steps = 0, rebuilds = 0;
     bool needs_rebuild = false;
 };
@@ -159,9 +178,11 @@ public:
                        detail::interact<Real, Law>{p, lists_.view(), settings_.box, walls_, settings_.contact,
                                                    settings_.wall, dt_});
         for_each_index(Policy{}, n, detail::integrate_particles<Real, Integrator>{p, settings_.box, settings_.gravity, dt_});
-        const detail::wall_forces on_walls = transform_reduce(
-            Policy{}, n, detail::particle_wall_forces<Real>{lists_.view().wall_force}, detail::wall_forces{}, plus_op{});
-        advance_walls(walls_, settings_.walls, settings_.box, on_walls.f, time_, dt_, steps_ + 1);
+        const detail::boundary_loads loads =
+            transform_reduce(Policy{}, n, detail::particle_boundary_loads<Real>{p, lists_.view().wall_force, settings_.gravity},
+                             detail::boundary_loads{}, plus_op{});
+        advance_walls(walls_, settings_.walls, settings_.box, loads.wall_force, time_, dt_, steps_ + 1);
+        drive_work_ += loads.drive_power * double(dt_);
         const detail::step_check<Real> check = transform_reduce(
             Policy{}, n, detail::check_particle<Real>{p, x_at_build_.data(), settings_.box, walls_},
             detail::step_check<Real>{0, ~std::size_t(0)}, detail::combine_checks{});
@@ -210,6 +231,35 @@ public:
         settings_.walls[f] = control;
     }
 
+    /// Moves wall face f (an active one) to `position` (m along its axis) and stops it there,
+    /// e.g. down onto a deposited sample before it is loaded. Throws when the face is periodic,
+    /// the position lies outside the world or beyond the opposite wall, or some particle's
+    /// centre would be outside the wall.
+    void set_wall_position(int f, double position)
+    {
+        if (f < 0 || f >= wall_set<Real>::count) detail::fail("set_wall_position: face ", f, " out of range [0, 6)");
+        const int a = f / 2;
+        if (!walls_.face[f].active)
+            detail::fail("set_wall_position: axis ", a, " is periodic, so face ", f, " has no wall");
+        if (!(position >= double(settings_.box.lo[a]) && position <= double(settings_.box.hi[a])))
+            detail::fail("set_wall_position: face ", f, " at ", position, " m lies outside the world [",
+                         settings_.box.lo[a], ", ", settings_.box.hi[a], "] m on axis ", a);
+        const double opposite = walls_.face[f ^ 1].position;
+        if (f % 2 == 0 ? !(position < opposite) : !(position > opposite))
+            detail::fail("set_wall_position: face ", f, " at ", position, " m would cross the opposite wall at ",
+                         opposite, " m");
+        const particle_snapshot<Real> s = particles_.snapshot();
+        for (std::size_t i = 0; i < s.size(); ++i) {
+            const double x = double(s.position(i)[a]);
+            if (f % 2 == 0 ? x < position : x > position)
+                detail::fail("set_wall_position: particle ", i, " at ", x, " m on axis ", a, " would lie outside face ",
+                             f, " at ", position, " m");
+        }
+        walls_.face[f].position = position;
+        walls_.face[f].velocity = 0;
+        needs_rebuild_ = true;
+    }
+
     std::size_t size() const { return particles_.size(); }
     Real dt() const { return dt_; }
     /// Simulated time (s), steps() * dt() in double.
@@ -219,6 +269,9 @@ public:
     std::size_t rebuilds() const { return rebuilds_; }
     const settings<Real>& config() const { return settings_; }
     const wall_set<Real>& walls() const { return walls_; }
+    /// Work done on the particles by whatever drives the prescribed ones, so far (J); part of
+    /// energy().boundary_work, with the work of the walls.
+    double drive_work() const { return drive_work_; }
     const grid_geometry<Real>& grid() const { return grid_.geometry(); }
 
     /// A host copy of every particle field.
@@ -234,7 +287,9 @@ public:
             detail::particle_energy<Real, Law>{self.particles_.view(), self.lists_.view(), settings_.box, walls_,
                                                settings_.contact, settings_.wall, settings_.gravity},
             energy_budget<Real>{}, plus_op{});
-        for (const wall_face<Real>& w : walls_.face) e.boundary_work += Real(w.work);
+        double work = drive_work_;
+        for (const wall_face<Real>& w : walls_.face) work += w.work;
+        e.boundary_work = Real(work);
         return e;
     }
 
@@ -242,20 +297,28 @@ public:
     /// continues bit-identically.
     simulation_state<Real> state() const
     {
-        return {particles_.snapshot(), lists_.counts(),    lists_.partners(), lists_.histories(),
-                lists_.wall_histories(), x_at_build_.to_host(), walls_,          steps_,
-                rebuilds_,               needs_rebuild_};
+        return {particles_.snapshot(),  lists_.counts(), lists_.partners(), lists_.histories(),
+                lists_.wall_histories(), x_at_build_.to_host(), walls_,         drive_work_,
+                steps_,                 rebuilds_,       needs_rebuild_};
     }
 
-    /// Continues from a state taken from a simulation with the same settings and particle count.
+    /// Continues from a state taken from a simulation with the same settings and particle count,
+    /// possibly edited on the host (e.g. particles turned into a shear cell's driven layers by
+    /// make_shear_cell: the motion kinds are taken from the state).
     void restore(const simulation_state<Real>& s)
     {
         if (s.particles.size() != size())
             detail::fail("restore: the state holds ", s.particles.size(), " particles, the simulation ", size());
+        for (std::size_t i = 0; i < size(); ++i)
+            if (s.particles.kind[i] > last_motion)
+                detail::fail("restore: particle ", i, " has motion kind ", unsigned(s.particles.kind[i]), ", at most ",
+                             unsigned(last_motion), " is valid");
+        for (std::size_t i = 0; i < size(); ++i) kinds_[i] = static_cast<motion>(s.particles.kind[i]);
         particles_.restore(s.particles);
         lists_.restore(s.counts, s.partners, s.histories, s.wall_histories);
         x_at_build_.assign(s.x_at_build);
         walls_ = s.walls;
+        drive_work_ = s.drive_work;
         steps_ = s.steps;
         rebuilds_ = s.rebuilds;
         needs_rebuild_ = s.needs_rebuild;
@@ -303,6 +366,7 @@ private:
     settings<Real> settings_;
     Real dt_ = 0;
     double time_ = 0;
+    double drive_work_ = 0; ///< work done on the prescribed particles so far (J)
     std::size_t steps_ = 0, rebuilds_ = 0;
     bool needs_rebuild_ = true;
     particle_state<Real, Policy> particles_;

@@ -2,7 +2,8 @@
 /// \file
 /// Shear strain and shear velocity of a shear experiment (sphere's shearStrain and shearVel).
 /// The sample lies between a rough bottom of fixed particles (motion::fixed) and a top layer
-/// of prescribed particles (motion::prescribed) moved along a horizontal axis. sphere takes
+/// of prescribed particles (motion::prescribed or prescribed_horizontal) moved along a
+/// horizontal axis. sphere takes
 /// the top particles' displacement (time times their velocity) over the upper wall's height
 /// above the floor. Here the displacement is measured (periodic wraps unfolded) relative to the
 /// bottom layer, and divided by the distance between the two layers' mean centres: the height
@@ -26,18 +27,19 @@ namespace sphere {
 
 /// The two driving layers of a shear experiment: particle indices.
 struct shear_layers {
-    std::vector<std::size_t> top;    ///< prescribed particles (moved at the shear velocity)
+    std::vector<std::size_t> top;    ///< prescribed particles, either kind (moved at the shear velocity)
     std::vector<std::size_t> bottom; ///< fixed particles (the rough bottom)
 };
 
-/// The prescribed (top) and fixed (bottom) particles of a snapshot; throws when either set is
-/// empty.
+/// The prescribed or horizontally prescribed (top) and fixed (bottom) particles of a snapshot;
+/// throws when either set is empty.
 template <class Real>
 shear_layers find_shear_layers(const particle_snapshot<Real>& s)
 {
     shear_layers l;
     for (std::size_t i = 0; i < s.size(); ++i) {
-        if (s.kind[i] == static_cast<std::uint8_t>(motion::prescribed)) l.top.push_back(i);
+        const auto kind = static_cast<motion>(s.kind[i]);
+        if (kind == motion::prescribed || kind == motion::prescribed_horizontal) l.top.push_back(i);
         if (s.kind[i] == static_cast<std::uint8_t>(motion::fixed)) l.bottom.push_back(i);
     }
     if (l.top.empty() || l.bottom.empty())
@@ -83,6 +85,20 @@ template <class Real>
 double shear_height(const particle_snapshot<Real>& s, const shear_layers& layers)
 {
     return detail::layer_mean_position(layers.top, s.x, 2) - detail::layer_mean_position(layers.bottom, s.x, 2);
+}
+
+/// Shear stress (Pa) on the sample: the force along `axis` (0 = x, 1 = y) that drives the top
+/// layer, which cancels the contact forces on it (docs/physics.md, "Driven particles"), over
+/// the horizontal area `area` (m^2): tau = -sum_top f_axis / area. Sampled after a step, it is
+/// that step's stress; average over many steps for a steady value.
+template <class Real>
+double shear_stress(const particle_snapshot<Real>& s, const shear_layers& layers, double area, int axis = 0)
+{
+    detail::check_shear_axis(axis);
+    if (!(area > 0) || !std::isfinite(area)) detail::fail("shear_stress: area = ", area, " m^2 must be positive and finite");
+    double sum = 0;
+    for (std::size_t i : layers.top) sum -= double(s.force[i][axis]);
+    return sum / area;
 }
 
 /// Follows the shear strain from a reference state on: call update() at least once per

@@ -14,7 +14,9 @@ namespace detail {
 
 /// Advances particle i by dt: free particles under contact force, torque and gravity with the
 /// integrator policy (moment of inertia 2/5 m r^2), prescribed ones at their own velocities,
-/// fixed ones not at all. Also stores the velocities at the new positions' time. Coordinates on periodic axes are wrapped back into the box.
+/// horizontally prescribed ones at their own x, y and angular velocities and along z under the
+/// contact force alone, fixed ones not at all. Also stores the velocities at the new positions'
+/// time. Coordinates on periodic axes are wrapped back into the box.
 template <class Real, class Integrator>
 struct integrate_particles {
     particle_view<Real> p;
@@ -38,6 +40,11 @@ struct integrate_particles {
             Integrator::advance(ang, w, alpha, dt);
             v_sync = Integrator::synchronous_velocity(v, a, dt);
             w_sync = Integrator::synchronous_velocity(w, alpha, dt);
+        } else if (kind == motion::prescribed_horizontal) {
+            const vec3<Real> a{0, 0, p.force[i].z / p.mass[i]}; // x and y stay at their velocity
+            Integrator::advance(pos, v, a, dt);
+            v_sync = Integrator::synchronous_velocity(v, a, dt);
+            ang += w * dt;
         } else {
             pos += v * dt;
             ang += w * dt;

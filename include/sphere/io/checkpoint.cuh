@@ -43,7 +43,7 @@
 namespace sphere {
 
 /// The checkpoint format version this build writes, and the only one it reads.
-inline constexpr std::uint32_t checkpoint_format_version = 1;
+inline constexpr std::uint32_t checkpoint_format_version = 2;
 
 /// The first 8 bytes of every checkpoint.
 inline constexpr char checkpoint_magic[9] = "SPHERECK";
@@ -304,6 +304,7 @@ std::string encode_checkpoint(const settings<Real>& config, Real dt, const simul
         e.f64(double(w.force));
         e.f64(double(w.work));
     }
+    e.f64(s.drive_work);
     const auto put_v4 = [](checkpoint_encoder& out, const vec4<Real>& v) { out.v4(v); };
     const auto put_v3 = [](checkpoint_encoder& out, const vec3<Real>& v) { out.v3(v); };
     const auto put_real = [](checkpoint_encoder& out, Real v) { out.f64(double(v)); };
@@ -421,6 +422,7 @@ checkpoint_data<Real> decode_checkpoint(const std::string& bytes, const std::str
             d.inconsistent("wall face ", f, " is ", w.active ? "active" : "inactive", " but axis ", f / 2, " is ",
                            s.box.periodic(f / 2) ? "periodic" : "closed by walls");
     }
+    st.drive_work = d.f64("the drive work");
     const auto get_v4 = [](checkpoint_decoder& in) { return in.v4<Real>("a 4-vector"); };
     const auto get_v3 = [](checkpoint_decoder& in) { return in.v3<Real>("a 3-vector"); };
     const auto get_real = [](checkpoint_decoder& in) { return Real(in.f64("a particle value")); };
@@ -439,7 +441,9 @@ checkpoint_data<Real> decode_checkpoint(const std::string& bytes, const std::str
     p.kind = d.array<std::uint8_t>("the motion kinds", n, 1,
                                    [](checkpoint_decoder& in) { return in.u8("a motion kind"); });
     for (std::size_t i = 0; i < p.kind.size(); ++i)
-        if (p.kind[i] > 2) d.inconsistent("particle ", i, " has motion kind ", unsigned(p.kind[i]), ", at most 2 is valid");
+        if (p.kind[i] > last_motion)
+            d.inconsistent("particle ", i, " has motion kind ", unsigned(p.kind[i]), ", at most ", unsigned(last_motion),
+                           " is valid");
     st.counts = d.array<unsigned>("the contact counts", n, 4, get_u32);
     st.partners = d.array<unsigned>("the contact partners", n * capacity, 4, get_u32);
     st.histories = d.array<vec4<Real>>("the contact histories", n * capacity, 32, get_v4);

@@ -170,7 +170,7 @@ std::string vtu_text(const particle_snapshot<Real>& p, double time)
 /// Points are the particle centres (m); point data: radius (m), velocity (m/s) and
 /// angular_velocity (rad/s) at the time of the positions (v_sync, omega_sync), angular_position
 /// (rad), force (N) and torque (N m) of the last step's contacts, mass (kg), pressure (Pa),
-/// dissipated_viscous and dissipated_frictional (J), kind (0 free, 1 prescribed, 2 fixed);
+/// dissipated_viscous and dissipated_frictional (J), kind (0 free, 1 prescribed, 2 fixed, 3 prescribed_horizontal);
 /// field data TimeValue (s). Throws sphere::error naming the file when it cannot be written.
 template <class Real>
 void write_vtu(const std::string& path, const particle_snapshot<Real>& p, double time)

@@ -12,7 +12,14 @@ enum class motion : std::uint8_t {
     free = 0,       ///< moves under its forces, torques and gravity
     prescribed = 1, ///< moves at its own velocity and angular velocity, which never change by force
     fixed = 2,      ///< never moves; velocity and angular velocity are zero
+    /// moves at its own x and y velocity and its own angular velocity, and along z under its
+    /// contact forces alone, without gravity: sphere's `fixvel` top layer of a shear test, which
+    /// is driven horizontally and free to dilate (docs/physics.md, "Driven particles")
+    prescribed_horizontal = 3,
 };
+
+/// The largest valid motion value.
+inline constexpr std::uint8_t last_motion = static_cast<std::uint8_t>(motion::prescribed_horizontal);
 
 /// One sphere: SI units throughout.
 template <class Real>

@@ -3,6 +3,7 @@
 /// Setup checks of particle descriptions against the world box.
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <limits>
 #include <vector>
 
@@ -32,6 +33,9 @@ void validate_particles(const std::vector<particle<Real>>& particles, const worl
             detail::fail("particle ", i, ": velocity (", p.velocity.x, ", ", p.velocity.y, ", ", p.velocity.z,
                          ") m/s or angular velocity (", p.angular_velocity.x, ", ", p.angular_velocity.y, ", ",
                          p.angular_velocity.z, ") rad/s is not finite");
+        if (static_cast<std::uint8_t>(p.kind) > last_motion)
+            detail::fail("particle ", i, ": motion kind ", unsigned(static_cast<std::uint8_t>(p.kind)), " is not one of ",
+                         "free (0), prescribed (1), fixed (2) or prescribed_horizontal (3)");
         for (int a = 0; a < 3; ++a)
             if (!box.periodic(a) && !(p.position[a] >= box.lo[a] && p.position[a] <= box.hi[a]))
                 detail::fail("particle ", i, ": position[", a, "] = ", p.position[a], " m lies outside the world [",

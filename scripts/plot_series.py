@@ -1,0 +1,207 @@
+#!/usr/bin/python3
+"""Plot a sphere CSV time series (docs/io.md, "CSV time series") as PNG figures.
+
+Usage: /usr/bin/python3 scripts/plot_series.py SERIES.csv [--out DIR]
+
+The CSV has a header line of `name_unit` columns and rows of numbers. Columns read:
+  required   time_s, kinetic_J, rotational_J, potential_J, elastic_J, dissipated_visc_J,
+             dissipated_fric_J, boundary_work_J, total_J
+  walls      wall_<face>_position_m, wall_<face>_force_N (face: xlo xhi ylo yhi zlo zhi);
+             normal_stress_Pa
+  porosity   porosity, void_ratio (derived from porosity when absent)
+  shear      shear_strain, shear_stress_Pa, friction_coefficient, dilation_m
+Other columns (wall velocities, side_stress_Pa, axial_strain, ...) are read but not plotted.
+
+Figures, written to DIR (default: the CSV's folder), one printed line (the path) each:
+  energy.png    energy budget and the balance total_J - total_J[0] against time (always)
+  walls.png     positions and forces of the moving walls, normal stress (when wall columns exist)
+  porosity.png  porosity and void ratio against time (when `porosity` exists)
+  shear.png     shear stress, friction coefficient and dilation against shear strain
+                (when `shear_strain` exists)
+Errors (unreadable file, bad header or row, no rows) print one message naming the file to
+stderr and exit with status 2, before any figure is written.
+"""
+import argparse
+import os
+import sys
+
+import matplotlib
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+ENERGY_COLUMNS = ["time_s", "kinetic_J", "rotational_J", "potential_J", "elastic_J",
+                  "dissipated_visc_J", "dissipated_fric_J", "boundary_work_J", "total_J"]
+FACES = ["xlo", "xhi", "ylo", "yhi", "zlo", "zhi"]
+
+
+class SeriesError(Exception):
+    """A problem with the input, reported as `plot_series: <message>` and exit status 2."""
+
+
+def read_series(path):
+    """Returns {column name: numpy array} for the CSV at `path`; raises SeriesError."""
+    try:
+        with open(path, encoding="utf-8") as f:
+            lines = f.read().splitlines()
+    except (OSError, UnicodeDecodeError) as e:
+        raise SeriesError(f"cannot read '{path}': {getattr(e, 'strerror', None) or e}")
+    if not lines or not lines[0].strip():
+        raise SeriesError(f"'{path}' is empty (no header line)")
+    names = [n.strip() for n in lines[0].split(",")]
+    if len(set(names)) != len(names):
+        raise SeriesError(f"'{path}' line 1: repeated column name in the header")
+    missing = [c for c in ENERGY_COLUMNS if c not in names]
+    if missing:
+        raise SeriesError(f"'{path}' line 1: header lacks the column(s) {', '.join(missing)}")
+    rows = []
+    for number, line in enumerate(lines[1:], start=2):
+        values = line.split(",")
+        if len(values) != len(names):
+            raise SeriesError(f"'{path}' line {number}: expected {len(names)} values, "
+                              f"found {len(values) if line.strip() else 0}")
+        try:
+            rows.append([float(v) for v in values])
+        except ValueError:
+            bad = next(v for v in values if not _is_number(v))
+            raise SeriesError(f"'{path}' line {number}: '{bad.strip()}' is not a number") from None
+    if not rows:
+        raise SeriesError(f"'{path}' has a header but no data rows")
+    data = np.array(rows, dtype=float)
+    return {name: data[:, c] for c, name in enumerate(names)}
+
+
+def _is_number(text):
+    try:
+        float(text)
+        return True
+    except ValueError:
+        return False
+
+
+def plot_energy(s):
+    t = s["time_s"]
+    fig, (top, bottom) = plt.subplots(2, 1, sharex=True, figsize=(9, 7),
+                                      gridspec_kw={"height_ratios": [3, 1]})
+    curves = [("kinetic + rotational", s["kinetic_J"] + s["rotational_J"]),
+              ("potential - initial", s["potential_J"] - s["potential_J"][0]),
+              ("elastic", s["elastic_J"]),
+              ("viscous dissipation", s["dissipated_visc_J"]),
+              ("frictional dissipation", s["dissipated_fric_J"]),
+              ("boundary work", s["boundary_work_J"])]
+    for label, y in curves:
+        top.plot(t, y, label=label)
+    top.set_ylabel("energy [J]")
+    top.legend(fontsize="small")
+    bottom.plot(t, s["total_J"] - s["total_J"][0], color="k", label="total - initial total")
+    bottom.set_ylabel("balance [J]")
+    bottom.set_xlabel("time [s]")
+    bottom.legend(fontsize="small")
+    fig.suptitle("Energy budget")
+    return fig
+
+
+def plot_walls(s):
+    t = s["time_s"]
+    faces = [f for f in FACES if f"wall_{f}_position_m" in s]
+    moving = [f for f in faces if np.any(s[f"wall_{f}_position_m"] != s[f"wall_{f}_position_m"][0])]
+    with_stress = "normal_stress_Pa" in s
+    fig, axes = plt.subplots(3 if with_stress else 2, 1, sharex=True, figsize=(9, 9 if with_stress else 7))
+    for f in moving:
+        axes[0].plot(t, s[f"wall_{f}_position_m"], label=f)
+    if moving:
+        axes[0].legend(fontsize="small", title="wall")
+    else:
+        axes[0].text(0.5, 0.5, "no wall moves", ha="center", va="center", transform=axes[0].transAxes)
+    axes[0].set_ylabel("position [m]")
+    # The forces of the moving walls; when none moves, those of every wall.
+    for f in moving or faces:
+        if f"wall_{f}_force_N" in s:
+            axes[1].plot(t, s[f"wall_{f}_force_N"], label=f)
+    axes[1].set_ylabel("force along axis [N]")
+    if axes[1].lines:
+        axes[1].legend(fontsize="small", title="wall")
+    if with_stress:
+        axes[2].plot(t, s["normal_stress_Pa"] / 1e3, color="k", label="normal stress")
+        axes[2].set_ylabel("normal stress [kPa]")
+        axes[2].legend(fontsize="small")
+    axes[-1].set_xlabel("time [s]")
+    fig.suptitle("Walls")
+    return fig
+
+
+def plot_porosity(s):
+    t = s["time_s"]
+    void = s["void_ratio"] if "void_ratio" in s else s["porosity"] / (1 - s["porosity"])
+    fig, ax = plt.subplots(figsize=(9, 5))
+    ax.plot(t, s["porosity"], color="C0", label="porosity")
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel("porosity [-]")
+    twin = ax.twinx()
+    twin.plot(t, void, color="C1", linestyle="--", label="void ratio")
+    twin.set_ylabel("void ratio [-]")
+    ax.legend(handles=ax.lines + twin.lines, fontsize="small")
+    fig.suptitle("Porosity")
+    return fig
+
+
+def plot_shear(s):
+    gamma = s["shear_strain"]
+    fig, (top, bottom) = plt.subplots(2, 1, sharex=True, figsize=(9, 7))
+    handles = []
+    if "shear_stress_Pa" in s:
+        handles += top.plot(gamma, s["shear_stress_Pa"] / 1e3, color="C0", label="shear stress")
+    top.set_ylabel("shear stress [kPa]")
+    if "friction_coefficient" in s:
+        twin = top.twinx()
+        handles += twin.plot(gamma, s["friction_coefficient"], color="C1", linestyle="--",
+                             label="friction coefficient")
+        twin.set_ylabel("friction coefficient [-]")
+    if handles:
+        top.legend(handles=handles, fontsize="small")
+    if "dilation_m" in s:
+        bottom.plot(gamma, s["dilation_m"] * 1e3, color="C2", label="dilation")
+        bottom.legend(fontsize="small")
+    bottom.set_ylabel("dilation [mm]")
+    bottom.set_xlabel("shear strain [-]")
+    fig.suptitle("Shear")
+    return fig
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description="Plot a sphere CSV time series as PNG figures.")
+    parser.add_argument("csv", help="the CSV time series")
+    parser.add_argument("--out", help="folder for the figures (default: the CSV's folder)")
+    args = parser.parse_args(argv)
+    out = args.out if args.out is not None else (os.path.dirname(args.csv) or ".")
+    try:
+        s = read_series(args.csv)
+        figures = [("energy.png", plot_energy)]
+        if any(name.startswith("wall_") for name in s):
+            figures.append(("walls.png", plot_walls))
+        if "porosity" in s:
+            figures.append(("porosity.png", plot_porosity))
+        if "shear_strain" in s:
+            figures.append(("shear.png", plot_shear))
+        try:
+            os.makedirs(out, exist_ok=True)
+        except OSError as e:
+            raise SeriesError(f"cannot create the output folder '{out}' for '{args.csv}': {e.strerror}")
+        for name, plot in figures:
+            path = os.path.join(out, name)
+            fig = plot(s)
+            try:
+                fig.savefig(path, dpi=100)
+            except OSError as e:
+                raise SeriesError(f"cannot write '{path}' (from '{args.csv}'): {e.strerror or e}")
+            finally:
+                plt.close(fig)
+            print(path)
+    except SeriesError as e:
+        print(f"plot_series: {e}", file=sys.stderr)
+        return 2
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
