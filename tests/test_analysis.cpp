@@ -462,3 +462,29 @@ TEMPLATE_TEST_CASE("shear strain and velocity of a prescribed top layer over a f
     sphere::simulation<Real> plain(s, free_only);
     CHECK_THROWS_WITH(sphere::shear_tracker<Real>(plain), Catch::Contains("needs both"));
 }
+
+TEMPLATE_TEST_CASE("Love-Weber counts the friction of wall contacts", "[analysis][stress]", float, double)
+{
+    using Real = TestType;
+    // One set-P sphere pressed 1e-4 m into the floor (f_n = k_n 1e-4 = 10 N, undamped) and
+    // dragged along x at 0.1 m/s: the floor's viscous friction (gamma_t 0.1 m/s = 10 N) is
+    // capped at mu f_n = 3 N against the motion. Both act at the contact point, l = r - 1e-4
+    // below the centre: sigma_ab = -(1/V) f_a l_b with f = (-mu f_n, 0, f_n), l = (0, 0, -l),
+    // so sigma_zz = f_n l / V and sigma_xz = -mu f_n l / V.
+    const Real R = sphere_test::set_p<Real>::radius;
+    sphere::settings<Real> s = sphere_test::box_settings<Real>();
+    s.wall.gamma_t = Real(100);
+    s.wall.mu_s = s.wall.mu_d = Real(0.3);
+    sphere::particle<Real> p = sphere_test::ball<Real>({0, 0, Real(-0.1) + R - Real(1e-4)}, {Real(0.1), 0, 0});
+    p.kind = sphere::motion::prescribed;
+    sphere::simulation<Real> sim(s, {p});
+    sim.step();
+    const double volume = 0.2 * 0.2 * 0.2;
+    const sphere::stress_tensor t = sphere::love_weber_stress(sim, volume);
+    const double l = double(R) - 1e-4, fn = 1e5 * 1e-4;
+    const double tol = std::is_same<Real, float>::value ? 1e-4 : 1e-9;
+    CHECK(t.s[2][2] == Approx(fn * l / volume).epsilon(tol));
+    CHECK(t.s[0][2] == Approx(-0.3 * fn * l / volume).epsilon(tol));
+    CHECK(t.s[2][0] == 0); // the branch vector has no x component
+    CHECK(t.s[0][0] == 0);
+}

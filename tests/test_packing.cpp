@@ -356,8 +356,8 @@ poured pour(std::size_t n, double width_d, double mu, double kappa, double dt_fa
         out.top = std::max(out.top, double(snap.x[i].z) + double(snap.x[i].w));
         out.weight += double(snap.mass[i]) * g;
     }
-    const std::vector<Real> wf = sim.contacts().wall_forces();
-    for (std::size_t i = 0; i < n; ++i) out.floor_force += double(wf[i * 6 + 4]);
+    const std::vector<sphere::vec3<Real>> wf = sim.contacts().wall_forces();
+    for (std::size_t i = 0; i < n; ++i) out.floor_force += double(wf[i * 6 + 4].z);
     const sphere::porosity_result core =
         sphere::porosity_in_box(snap.x, s.box, {0, 0, 3 * d}, {width, width, out.top - 4 * d});
     out.core_fraction = 1 - core.porosity;

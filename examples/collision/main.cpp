@@ -3,12 +3,12 @@
 // values of the linear contact model, and writes a CSV time series. With no options it runs
 // an elastic-viscous head-on pair of the validation set P (docs/examples.md).
 #include <sphere/dem.cuh>
+#include <sphere/io/atomic_file.cuh>
 
 #include <CLI/CLI.hpp>
 
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <iostream>
 #include <sstream>
 #include <string>
@@ -24,26 +24,6 @@ struct options {
     bool tension = false;
     std::string precision = "double", backend = "host", csv = "collision.csv";
 };
-
-/// Writes `text` to `path` through a temporary file and a rename, so that an interrupted run
-/// never leaves a half-written file behind.
-void write_file_atomically(const std::string& path, const std::string& text)
-{
-    const std::string tmp = path + ".tmp";
-    {
-        std::ofstream out(tmp, std::ios::binary);
-        out << text;
-        out.flush();
-        if (!out) {
-            std::remove(tmp.c_str());
-            throw sphere::error("cannot write the CSV output '" + path + "' (through '" + tmp + "')");
-        }
-    }
-    if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-        std::remove(tmp.c_str());
-        throw sphere::error("cannot rename '" + tmp + "' to the CSV output '" + path + "'");
-    }
-}
 
 template <class Real, class Policy>
 int run(const options& o)
@@ -139,7 +119,7 @@ int run(const options& o)
                 double(e1.dissipated_visc), double(e1.dissipated_fric));
     std::printf("%-28s %14.6e %14s %10.2e\n", "energy balance error (J)", before - after - dissipated, "0",
                 std::fabs(before - after - dissipated) / before);
-    write_file_atomically(o.csv, csv.str());
+    write_file_atomically(o.csv, csv.str()); // sphere::, through a temporary file and a rename
     std::printf("time series written to %s\n", o.csv.c_str());
     return 0;
 }

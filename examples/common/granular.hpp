@@ -83,7 +83,9 @@ sphere::contact_params<Real> contact_of(const sample_options& o)
 }
 
 /// A sample poured under gravity (-z, 9.81 m/s^2) and come to rest (kinetic energy below
-/// 1e-5 of n m g d): random non-overlapping centres in a column about as wide as the settled
+/// 1e-4 of n m g d: low enough for a packing whose grains have stopped falling, high enough
+/// that one grain still rolling on the bottom wall, which nothing slows down in the absence of
+/// rolling resistance, does not keep the deposition running): random non-overlapping centres in a column about as wide as the settled
 /// sample will be tall, filled to a solid fraction of 0.25, in a world periodic on x and y
 /// (side_walls = false) or closed by walls on every side (the world then extends half a width
 /// beyond the side walls, so that they can move out); the world is fitted to the column, and
@@ -127,7 +129,7 @@ granular_sim<Real> deposited_sample(const sample_options& o, bool side_walls, co
             sim.set_wall_position(2 * a + 1, double(fitted.hi[a]));
         }
     const double m = sphere_mass(r, o.density);
-    deposit(sim, 1e-5 * double(o.particles) * m * 9.81 * 2 * r, 2000000, 200);
+    deposit(sim, 1e-4 * double(o.particles) * m * 9.81 * 2 * r, 2000000, 200);
     sim.set_wall_position(5, sample_top(sim.snapshot()));
     return sim;
 }

@@ -58,12 +58,12 @@ struct boundary_loads {
 template <class Real>
 struct particle_boundary_loads {
     particle_view<Real> p;
-    const Real* wall_force; ///< force of face f on particle i along the axis, at [i * 6 + f]
+    const vec3<Real>* wall_force; ///< force of face f on particle i, at [i * 6 + f]
     vec3<Real> gravity;
     SPHERE_HD boundary_loads operator()(std::size_t i) const
     {
         boundary_loads out;
-        for (int k = 0; k < 6; ++k) out.wall_force[k] = -double(wall_force[i * 6 + k]);
+        for (int k = 0; k < 6; ++k) out.wall_force[k] = -double(wall_force[i * 6 + k][k / 2]);
         out.drive_power = 0;
         const auto kind = static_cast<motion>(p.kind[i]);
         if (kind == motion::prescribed || kind == motion::prescribed_horizontal) {
@@ -177,7 +177,8 @@ public:
         for_each_index(Policy{}, n,
                        detail::interact<Real, Law>{p, lists_.view(), settings_.box, walls_, settings_.contact,
                                                    settings_.wall, dt_});
-        for_each_index(Policy{}, n, detail::integrate_particles<Real, Integrator>{p, settings_.box, settings_.gravity, dt_});
+        for_each_index(Policy{}, n, detail::integrate_particles<Real, Integrator>{p, settings_.box, settings_.gravity, dt_,
+                                                                             external_.size() ? external_.data() : nullptr});
         const detail::boundary_loads loads =
             transform_reduce(Policy{}, n, detail::particle_boundary_loads<Real>{p, lists_.view().wall_force, settings_.gravity},
                              detail::boundary_loads{}, plus_op{});
@@ -278,6 +279,20 @@ public:
     particle_snapshot<Real> snapshot() const { return particles_.snapshot(); }
     const contact_lists<Real, Policy>& contacts() const { return lists_; }
 
+    /// Kernel view of the particle fields (policy memory, user order), for couplings that read
+    /// positions and velocities between steps (the pore fluid). Writing through it is undefined.
+    particle_view<Real> particle_data() { return particles_.view(); }
+
+    /// External forces on the particles (N; policy memory, one per particle in user order), added
+    /// to the contact force of every free particle at each step until overwritten; zero until
+    /// written. The pore-fluid coupling writes them (docs/fluid.md, *Coupling*). Their work is
+    /// not part of energy().boundary_work.
+    vec3<Real>* external_forces()
+    {
+        if (external_.size() != size()) external_ = buffer<vec3<Real>, Policy>(size(), vec3<Real>{0, 0, 0});
+        return external_.data();
+    }
+
     /// Kinetic, rotational, potential and elastic energies and the dissipated energies (J).
     energy_budget<Real> energy() const
     {
@@ -374,6 +389,7 @@ private:
     neighbor_grid<Real, Policy> grid_;
     contact_lists<Real, Policy> lists_;
     buffer<vec4<Real>, Policy> x_at_build_;
+    buffer<vec3<Real>, Policy> external_; ///< external forces (empty until external_forces() is called)
     std::vector<motion> kinds_; ///< host copy of each particle's motion (it never changes)
     std::vector<std::pair<std::size_t, observer>> observers_;
 };

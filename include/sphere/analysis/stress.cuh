@@ -45,7 +45,7 @@ struct contact_snapshot {
     std::vector<unsigned> counts;     ///< partners listed per particle (contact_lists layout)
     std::vector<unsigned> partners;   ///< partner of entry k of particle i at [i * capacity + k]
     std::vector<vec4<Real>> forces;   ///< per entry: tangential force on i (N) in xyz, f_n . n (N) in w
-    std::vector<Real> wall_forces;    ///< force of face f on particle i along its axis (N), [i * 6 + f]
+    std::vector<vec3<Real>> wall_forces; ///< force of face f on particle i (N), [i * 6 + f]
     std::size_t capacity = 0;         ///< entries per particle
     world<Real> box;                  ///< the world (periodic axes for nearest images)
     wall_set<Real> walls;             ///< the walls, with their positions
@@ -109,10 +109,9 @@ double volume_between_walls(const wall_set<Real>& walls, const world<Real>& box)
 /// contacts. A pair's two terms add up to f (on i) times the centre-to-centre vector
 /// x_j - x_i (nearest periodic image), so each listed entry (every pair appears once from each
 /// side) contributes half of that. A wall contact has its branch vector from the centre to the
-/// wall plane along the wall's axis. The library records only the axis component of a wall
-/// contact's force (contact_view::wall_force), so wall friction is missing from the entries
-/// sigma_ba (b not the wall's axis a); with frictionless walls the sum is complete. In a static
-/// assembly without body forces, sigma_aa equals the walls' normal stress on a wall axis.
+/// wall plane along the wall's axis, and its whole force (normal and friction) counts. In a
+/// static assembly without body forces, sigma_aa equals the walls' normal stress on a wall
+/// axis.
 /// V (m^3) must be positive.
 template <class Real>
 stress_tensor love_weber_stress(const contact_snapshot<Real>& c, double volume)
@@ -140,10 +139,11 @@ stress_tensor love_weber_stress(const contact_snapshot<Real>& c, double volume)
         }
         for (int f = 0; f < wall_set<Real>::count; ++f) {
             if (!c.walls.face[f].active) continue;
-            const double fa = double(c.wall_forces[i * wall_set<Real>::count + f]);
-            if (fa == 0) continue;
+            const vec3<Real> fw = c.wall_forces[i * wall_set<Real>::count + f];
+            if (fw.x == Real(0) && fw.y == Real(0) && fw.z == Real(0)) continue;
             const int a = f / 2;
-            t.s[a][a] -= fa * (double(c.walls.face[f].position) - double(xi[a]));
+            const double l = double(c.walls.face[f].position) - double(xi[a]); // branch vector l e_a
+            for (int b = 0; b < 3; ++b) t.s[b][a] -= double(fw[b]) * l;
         }
     }
     for (int a = 0; a < 3; ++a)
@@ -177,7 +177,7 @@ std::vector<unsigned> contact_counts(const contact_snapshot<Real>& c, bool with_
             if (c.touching(i * c.capacity + k)) ++z[i];
         if (with_walls)
             for (int f = 0; f < wall_set<Real>::count; ++f)
-                if (c.walls.face[f].active && c.wall_forces[i * wall_set<Real>::count + f] != Real(0)) ++z[i];
+                if (c.walls.face[f].active && norm2(c.wall_forces[i * wall_set<Real>::count + f]) > Real(0)) ++z[i];
     }
     return z;
 }

@@ -30,7 +30,7 @@ struct contact_view {
     vec4<Real>* history;    ///< history of that entry: delta_t (m) in xyz, sliding flag in w
     vec4<Real>* force;      ///< force of that entry in the last step: f_t (N) in xyz, f_n . n (N) in w
     vec4<Real>* wall_history; ///< history of particle i against wall face f at [i * 6 + f]
-    Real* wall_force;       ///< force of wall face f on particle i along the face's axis (N), [i * 6 + f]
+    vec3<Real>* wall_force; ///< force of wall face f on particle i (N), normal and friction, [i * 6 + f]
 };
 
 namespace detail {
@@ -139,7 +139,7 @@ public:
     contact_lists(std::size_t n, std::size_t capacity)
         : capacity_(capacity), count_(n, 0u), partner_(n * capacity, 0u), history_(n * capacity),
           force_(n * capacity), wall_history_(n * wall_set<Real>::count, vec4<Real>{0, 0, 0, 0}),
-          wall_force_(n * wall_set<Real>::count, Real(0)), new_count_(n, 0u), new_partner_(n * capacity, 0u),
+          wall_force_(n * wall_set<Real>::count, vec3<Real>{0, 0, 0}), new_count_(n, 0u), new_partner_(n * capacity, 0u),
           new_history_(n * capacity)
     {
     }
@@ -179,7 +179,7 @@ public:
     std::vector<vec4<Real>> histories() const { return history_.to_host(); }
     std::vector<vec4<Real>> wall_histories() const { return wall_history_.to_host(); }
     std::vector<vec4<Real>> forces() const { return force_.to_host(); }
-    std::vector<Real> wall_forces() const { return wall_force_.to_host(); }
+    std::vector<vec3<Real>> wall_forces() const { return wall_force_.to_host(); }
 
     /// Replaces the lists and their history (for restarts); sizes must match this store's.
     void restore(const std::vector<unsigned>& counts, const std::vector<unsigned>& partners,
@@ -199,7 +199,7 @@ private:
     std::size_t capacity_ = 0;
     buffer<unsigned, Policy> count_, partner_;
     buffer<vec4<Real>, Policy> history_, force_, wall_history_;
-    buffer<Real, Policy> wall_force_;
+    buffer<vec3<Real>, Policy> wall_force_;
     buffer<unsigned, Policy> new_count_, new_partner_;
     buffer<vec4<Real>, Policy> new_history_;
 };

@@ -74,7 +74,7 @@ struct interact {
             const Real dist = (xi.xyz()[a] - Real(wall.position)) * n[a];
             const Real delta_n = dist - xi.w;
             vec4<Real> h = c.wall_history[e];
-            Real on_axis = 0;
+            vec3<Real> on_particle{0, 0, 0};
             if (delta_n < Real(0)) {
                 contact_motion<Real> m{n, delta_n, vi + dist * cross(n, wi), (p.v[i] + dist * cross(n, p.omega[i])) * dt};
                 m.velocity[a] -= Real(wall.velocity);
@@ -85,12 +85,12 @@ struct interact {
                 fn_sum += r.fn;
                 visc += r.visc_rate;
                 fric += r.fric_rate;
-                on_axis = (r.normal + r.tangential)[a];
+                on_particle = r.normal + r.tangential;
             } else {
                 h = vec4<Real>{0, 0, 0, 0};
             }
             c.wall_history[e] = h;
-            c.wall_force[e] = on_axis;
+            c.wall_force[e] = on_particle;
         }
 
         p.force[i] = force;

@@ -16,7 +16,7 @@ namespace sphere {
 
 /// Below this many indices a host loop runs on the calling thread: starting a team of
 /// threads costs more than the work (and much more when the cores are busy).
-inline constexpr std::size_t host_parallel_threshold = 2048;
+inline constexpr std::size_t host_parallel_threshold = 256;
 
 template <class Body>
 void for_each_index(host, std::size_t n, const Body& body)

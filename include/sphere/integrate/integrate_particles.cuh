@@ -12,8 +12,8 @@
 namespace sphere {
 namespace detail {
 
-/// Advances particle i by dt: free particles under contact force, torque and gravity with the
-/// integrator policy (moment of inertia 2/5 m r^2), prescribed ones at their own velocities,
+/// Advances particle i by dt: free particles under contact force, external force (when
+/// `external` is not null: the pore fluid's), torque and gravity with the integrator policy (moment of inertia 2/5 m r^2), prescribed ones at their own velocities,
 /// horizontally prescribed ones at their own x, y and angular velocities and along z under the
 /// contact force alone, fixed ones not at all. Also stores the velocities at the new positions'
 /// time. Coordinates on periodic axes are wrapped back into the box.
@@ -23,6 +23,7 @@ struct integrate_particles {
     world<Real> box;
     vec3<Real> gravity;
     Real dt;
+    const vec3<Real>* external; ///< external force on each particle (N), or null
 
     SPHERE_HD void operator()(std::size_t i) const
     {
@@ -35,7 +36,8 @@ struct integrate_particles {
         if (kind == motion::free) {
             const Real m = p.mass[i];
             const Real inertia = Real(0.4) * m * x.w * x.w;
-            const vec3<Real> a = p.force[i] / m + gravity, alpha = p.torque[i] / inertia;
+            const vec3<Real> f = external ? p.force[i] + external[i] : p.force[i];
+            const vec3<Real> a = f / m + gravity, alpha = p.torque[i] / inertia;
             Integrator::advance(pos, v, a, dt);
             Integrator::advance(ang, w, alpha, dt);
             v_sync = Integrator::synchronous_velocity(v, a, dt);
