@@ -1,8 +1,14 @@
 #pragma once
 /// \file
 /// The fluid half of sphere: `#include <sphere/fluid.cuh>` brings in the fluid grid, the lens
-/// volume, the porosity estimator and the drag laws (docs/fluid.md).
+/// volume, the porosity estimator, the drag laws, the Poisson solvers, the Navier-Stokes
+/// solver and its coupling to the particles (docs/fluid.md).
+#include "fluid/coupling.cuh"
 #include "fluid/drag.cuh"
+#include "fluid/fluid_params.cuh"
 #include "fluid/grid.cuh"
 #include "fluid/lens.cuh"
+#include "fluid/navier_stokes.cuh"
+#include "fluid/poisson.cuh"
+#include "fluid/poisson_cg.cuh"
 #include "fluid/porosity.cuh"

@@ -189,6 +189,10 @@ public:
 
     const fluid_grid<Real>& grid() const { return grid_; }
 
+    /// The particles binned by fluid cell at the last update (bin index = fluid_grid::index of
+    /// the cell holding the particle's centre; sorted by particle index within a bin).
+    grid_view<Real> bins() const { return bins_.view(); }
+
     /// Radius R (m) of the cell spheres: half the smallest cell width.
     Real cell_sphere_radius() const { return grid_.min_width() / Real(2); }
 

@@ -1,0 +1,151 @@
+#pragma once
+/// \file
+/// Two-way coupling of the pore fluid and the particles (docs/fluid.md, *Coupling*).
+///
+/// One coupled step of length dt_f = dem_steps x (DEM time step):
+///   1. the porosity estimator bins the particles by fluid cell and computes each cell's
+///      porosity, its rate, and the lens-weighted mean particle velocity and diameter;
+///   2. every particle gets the fluid force of its cell (the cell holding its centre)
+///        f_i = Drag::beta_per_solid(phi, d, |v_f - v_p|) (v_f - v_p) V_i  [ - V_i grad p ]
+///      with the cell's porosity phi, fluid velocity v_f, mean particle velocity v_p and mean
+///      diameter d (the particle's own velocity and diameter where the cell sphere holds no
+///      solid); the bracket is the optional pressure-gradient (buoyancy) force;
+///   3. the fluid gets the opposite of the sum of its particles' forces, per unit cell volume,
+///      so that momentum is exchanged exactly (summed per cell in particle order:
+///      deterministic);
+///   4. the fluid advances by dt_f (its own stability limits checked), then the DEM by
+///      dem_steps steps with the forces held constant.
+/// The forces are explicit: dt_f must not exceed the shortest particle response time
+/// m_i / (beta_per_solid V_i) (checked; the step throws naming the particle).
+#include <cstddef>
+
+#include "../core/constants.cuh"
+#include "../core/error.cuh"
+#include "../core/vec.cuh"
+#include "../exec/algorithms.cuh"
+#include "../exec/for_each.cuh"
+#include "../grid/neighbor_grid.cuh"
+#include "../particles/state.cuh"
+#include "drag.cuh"
+#include "navier_stokes.cuh"
+#include "porosity.cuh"
+
+namespace sphere {
+
+/// How the fluid and the particles are coupled.
+struct coupling_options {
+    unsigned dem_steps = 10;     ///< DEM steps per fluid step
+    bool pressure_force = true;  ///< apply -V_p grad p to the particles (and its reaction to the fluid)
+};
+
+namespace detail {
+
+/// The fluid force on particle i (N), and its response time m / (drag coefficient) (s).
+template <class Real, class Drag>
+struct fluid_particle_force {
+    fluid_view<Real> f;
+    porosity_view<Real> por;
+    particle_view<Real> p;
+    vec3<Real>* out;
+    bool pressure_force;
+
+    SPHERE_HD long long cell_of(const vec3<Real>& x) const
+    {
+        int c[3];
+        for (int a = 0; a < 3; ++a) {
+            const Real s = (x[a] - f.grid.box.lo[a]) / f.grid.width[a];
+            int k = s > Real(0) ? int(s) : 0;
+            c[a] = k >= int(f.grid.n[a]) ? int(f.grid.n[a]) - 1 : k;
+        }
+        return f.at(c[0], c[1], c[2]);
+    }
+
+    SPHERE_HD Real operator()(std::size_t i) const
+    {
+        const vec4<Real> x = p.x[i];
+        const long long c = cell_of(x.xyz());
+        const Real r = x.w;
+        const Real V = Real(4) / Real(3) * pi<Real> * r * r * r;
+        const bool has_solid = por.d_p[c] > Real(0);
+        const Real d = has_solid ? por.d_p[c] : Real(2) * r;
+        const vec3<Real> v_p = has_solid ? por.v_p[c] : p.v_sync[i];
+        const vec3<Real> rel = f.cell_velocity(c) - v_p;
+        const Real phi = f.phi[c];
+        const Real k = Drag::beta_per_solid(phi, d, norm(rel), f.rho, f.mu) * V;
+        vec3<Real> force = rel * k;
+        if (pressure_force) force += drag::pressure_gradient_force(V, f.pressure_gradient(c));
+        out[i] = force;
+        return k > Real(0) ? p.mass[i] / k : Real(1e30);
+    }
+};
+
+/// The force density on the fluid in each cell (N/m^3): minus the sum of the forces on the
+/// particles whose centres lie in it, over the cell volume, in bin order.
+template <class Real>
+struct fluid_reaction {
+    fluid_view<Real> f;
+    grid_view<Real> bins;
+    const vec3<Real>* particle_force;
+
+    SPHERE_HD void operator()(std::size_t cell) const
+    {
+        int i, j, k;
+        f.grid.coordinates(cell, i, j, k);
+        vec3<Real> sum{0, 0, 0};
+        for (unsigned s = bins.cell_start[cell]; s < bins.cell_start[cell + 1]; ++s) sum += particle_force[bins.order[s]];
+        const Real volume = f.grid.width.x * f.grid.width.y * f.grid.width.z;
+        f.force[f.at(i, j, k)] = sum * (Real(-1) / volume);
+    }
+};
+
+} // namespace detail
+
+/// The pore fluid coupled to a simulation's particles. `Drag` is a drag law of sphere::drag,
+/// `Poisson` the pressure solver.
+template <class Real, class Policy, class Drag = drag::gidaspow, class Poisson = jacobi_poisson<Real, Policy>>
+class fluid_coupling {
+public:
+    fluid_coupling(const fluid_grid<Real>& g, const fluid_params<Real>& params, const coupling_options& options = {})
+        : options_(options), porosity_(g), fluid_(g, params)
+    {
+        if (options.dem_steps < 1) detail::fail("coupling: dem_steps = 0; at least one DEM step per fluid step");
+        Drag::validate();
+    }
+
+    navier_stokes<Real, Policy, Poisson>& fluid() { return fluid_; }
+    const porosity_estimator<Real, Policy>& porosity() const { return porosity_; }
+    const coupling_options& options() const { return options_; }
+
+    /// One coupled step (see the file comment): the fluid advances by dem_steps x sim.dt(), then
+    /// the simulation by dem_steps steps. Throws sphere::error, before the fluid and the
+    /// particles advance, when the fluid time step breaks a stability limit of the fluid or
+    /// exceeds a particle's response time to the drag.
+    template <class Simulation>
+    void step(Simulation& sim)
+    {
+        const Real dt = Real(options_.dem_steps) * sim.dt();
+        const particle_view<Real> p = sim.particle_data();
+        porosity_.update(p, dt);
+        fluid_.set_porosity(porosity_.view());
+        vec3<Real>* forces = sim.external_forces();
+        const Real response = transform_reduce(
+            Policy{}, p.n,
+            detail::fluid_particle_force<Real, Drag>{fluid_.view(), porosity_.view(), p, forces, options_.pressure_force},
+            Real(1e30), min_op{});
+        if (!(dt <= response))
+            detail::fail("coupling: the fluid step ", dt, " s (", options_.dem_steps, " DEM steps of ", sim.dt(),
+                         " s) exceeds the shortest particle response time m / (drag coefficient) = ", response,
+                         " s; use fewer DEM steps per fluid step");
+        for_each_index(Policy{}, fluid_.grid().cell_count(),
+                       detail::fluid_reaction<Real>{fluid_.view(), porosity_.bins(), forces});
+        fluid_.step(dt);
+        sim.run(options_.dem_steps);
+    }
+
+private:
+    coupling_options options_;
+    porosity_estimator<Real, Policy> porosity_;
+    navier_stokes<Real, Policy, Poisson> fluid_;
+};
+
+} // namespace sphere

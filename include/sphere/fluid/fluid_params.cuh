@@ -1,0 +1,79 @@
+#pragma once
+/// \file
+/// Material and boundary parameters of the pore fluid (docs/fluid.md, *Navier-Stokes solver*).
+#include <cmath>
+
+#include "../core/config.cuh"
+#include "../core/constants.cuh"
+#include "../core/error.cuh"
+#include "../core/vec.cuh"
+#include "poisson.cuh"
+
+namespace sphere {
+
+/// What the top or bottom of the fluid grid is.
+enum class fluid_boundary_kind {
+    no_flow,  ///< an impermeable, free-slip wall at the face of the grid (zero normal gradient of
+              ///< the pressure increment; zero normal velocity)
+    pressure  ///< a prescribed pressure held at the centres of the outermost cell layer (drained)
+};
+
+/// One z end of the fluid grid. For `pressure`, the value at time t is
+///   p(t) = pressure + amplitude sin(2 pi frequency t + phase)   (Pa).
+template <class Real>
+struct fluid_boundary {
+    fluid_boundary_kind kind = fluid_boundary_kind::no_flow;
+    Real pressure = 0;   ///< mean prescribed pressure (Pa)
+    Real amplitude = 0;  ///< amplitude of its sinusoidal modulation (Pa)
+    Real frequency = 0;  ///< modulation frequency (Hz)
+    Real phase = 0;      ///< modulation phase (rad)
+
+    Real value(double t) const
+    {
+        return Real(double(pressure) + double(amplitude) * std::sin(2 * pi<double> * double(frequency) * t + double(phase)));
+    }
+
+    static fluid_boundary no_flow() { return {}; }
+    static fluid_boundary prescribed_pressure(Real p, Real amplitude = 0, Real frequency = 0, Real phase = 0)
+    {
+        return {fluid_boundary_kind::pressure, p, amplitude, frequency, phase};
+    }
+};
+
+/// The fluid: a Newtonian liquid, water at 25 C by default.
+template <class Real>
+struct fluid_params {
+    Real density = Real(997.05);     ///< rho_f (kg/m^3)
+    Real viscosity = Real(8.90e-4);  ///< dynamic viscosity mu_f (Pa s)
+    /// Weight of the old pressure in the projection (Langtangen et al. 2002), in [0, 1]:
+    /// 0 is Chorin's method, 1 the incremental pressure-correction scheme.
+    Real beta = 0;
+    vec3<Real> gravity{0, 0, 0};     ///< g (m/s^2)
+    fluid_boundary<Real> bottom{};   ///< the z = lo end
+    fluid_boundary<Real> top{};      ///< the z = hi end
+    poisson_settings poisson{};      ///< tolerance and iteration limit of the pressure solve
+
+    /// Throws sphere::error naming the first invalid value.
+    void validate() const
+    {
+        if (!(density > 0) || !std::isfinite(density))
+            detail::fail("fluid: density = ", density, " kg/m^3 must be positive and finite");
+        if (!(viscosity > 0) || !std::isfinite(viscosity))
+            detail::fail("fluid: viscosity = ", viscosity, " Pa s must be positive and finite");
+        if (!(beta >= 0 && beta <= 1)) detail::fail("fluid: beta = ", beta, " must lie in [0, 1]");
+        for (int a = 0; a < 3; ++a)
+            if (!std::isfinite(gravity[a])) detail::fail("fluid: gravity component ", a, " = ", gravity[a], " is not finite");
+        const fluid_boundary<Real>* ends[2] = {&bottom, &top};
+        const char* names[2] = {"bottom", "top"};
+        for (int e = 0; e < 2; ++e) {
+            const auto& b = *ends[e];
+            if (!std::isfinite(b.pressure) || !std::isfinite(b.amplitude) || !std::isfinite(b.frequency) ||
+                !std::isfinite(b.phase))
+                detail::fail("fluid: the ", names[e], " boundary has a non-finite pressure, amplitude, frequency or phase");
+            if (b.frequency < 0)
+                detail::fail("fluid: the ", names[e], " boundary frequency = ", b.frequency, " Hz is negative");
+        }
+    }
+};
+
+} // namespace sphere

@@ -1,0 +1,591 @@
+#pragma once
+/// \file
+/// The fluid solver (docs/fluid.md, *Navier-Stokes solver*): the porosity-weighted
+/// Navier-Stokes equations of the pore fluid on a staggered (MAC) grid, advanced by
+/// Langtangen's operator splitting — an explicit predicted velocity, a Poisson equation for the
+/// pressure increment epsilon, and the projection that makes the velocity satisfy continuity.
+///
+/// Layout: pressure, porosity, its rate and the interaction force live at cell centres;
+/// velocity component a lives on the faces normal to axis a, face (i, j, k) of axis a being the
+/// one between cell (i, j, k) and its neighbour in +a. All use fluid_grid::field_index (one
+/// ghost layer). Along z, face k = -1 is the bottom of the grid and face nz - 1 its top.
+#include <cmath>
+#include <cstddef>
+#include <vector>
+
+#include "../core/error.cuh"
+#include "../core/vec.cuh"
+#include "../exec/algorithms.cuh"
+#include "../exec/buffer.cuh"
+#include "../exec/for_each.cuh"
+#include "fluid_params.cuh"
+#include "grid.cuh"
+#include "poisson.cuh"
+#include "porosity.cuh"
+
+namespace sphere {
+
+/// Kernel view of the fluid fields (device pointers for the cuda policy).
+template <class Real>
+struct fluid_view {
+    fluid_grid<Real> grid;
+    Real* p;            ///< pressure (Pa), cells
+    Real* u[3];         ///< face velocities (m/s), component a on the faces normal to a
+    Real* phi;          ///< porosity (-), cells
+    Real* dphi_dt;      ///< its rate of change (1/s), cells
+    vec3<Real>* force;  ///< interaction force density on the fluid (N/m^3), cells
+    long long stride[3];
+    Real rho, mu;
+    bool wall_bottom, wall_top;  ///< no-flow ends (else prescribed pressure)
+
+    SPHERE_HD long long at(int i, int j, int k) const
+    {
+        return ((long long)(k + 1) * (grid.n[1] + 2) + (j + 1)) * (grid.n[0] + 2) + (i + 1);
+    }
+    /// Whether the face of axis a at field index of cell (i, j, k) carries an unknown velocity:
+    /// every x and y face; the z faces between two cells.
+    SPHERE_HD bool active_face(int a, int k) const { return a != 2 || (k >= 0 && k < int(grid.n[2]) - 1); }
+    /// Porosity on face (c, a): the mean of the two cells it separates.
+    SPHERE_HD Real phi_face(long long c, int a) const { return Real(0.5) * (phi[c] + phi[c + stride[a]]); }
+    /// The fluid velocity at the centre of cell c: the mean of its two faces per axis.
+    SPHERE_HD vec3<Real> cell_velocity(long long c) const
+    {
+        vec3<Real> v;
+        for (int a = 0; a < 3; ++a) v[a] = Real(0.5) * (u[a][c] + u[a][c - stride[a]]);
+        return v;
+    }
+    /// The pressure gradient (Pa/m) at the centre of cell c: the mean of the two face gradients
+    /// per axis (the pressure ghosts along z are extrapolated linearly, so next to the top and
+    /// bottom this is the one-sided gradient).
+    SPHERE_HD vec3<Real> pressure_gradient(long long c) const
+    {
+        vec3<Real> g;
+        for (int a = 0; a < 3; ++a) g[a] = (p[c + stride[a]] - p[c - stride[a]]) / (Real(2) * grid.width[a]);
+        return g;
+    }
+};
+
+namespace detail {
+
+/// Source node of ghost node (i, j, k): periodic in x and y, nearest cell in z.
+SPHERE_HD inline void ghost_source(const unsigned n[3], int& i, int& j, int& k)
+{
+    const int nx = int(n[0]), ny = int(n[1]), nz = int(n[2]);
+    i = i < 0 ? i + nx : (i >= nx ? i - nx : i);
+    j = j < 0 ? j + ny : (j >= ny ? j - ny : j);
+    k = k < 0 ? 0 : (k >= nz ? nz - 1 : k);
+}
+
+SPHERE_HD inline void field_coordinates(const unsigned n[3], std::size_t f, int& i, int& j, int& k)
+{
+    i = int(f % (n[0] + 2)) - 1;
+    f /= (n[0] + 2);
+    j = int(f % (n[1] + 2)) - 1;
+    k = int(f / (n[1] + 2)) - 1;
+}
+
+SPHERE_HD inline bool is_ghost(const unsigned n[3], int i, int j, int k)
+{
+    return i < 0 || j < 0 || k < 0 || i >= int(n[0]) || j >= int(n[1]) || k >= int(n[2]);
+}
+
+/// Fills the ghost nodes of a cell-centred field: periodic copies in x and y; along z a copy
+/// of the nearest cell, or (extrapolate_z) the linear extrapolation 2 f(0) - f(1).
+template <class T>
+struct fill_cell_ghosts {
+    unsigned n[3];
+    T* f;
+    bool extrapolate_z;
+
+    SPHERE_HD void operator()(std::size_t node) const
+    {
+        int i, j, k;
+        field_coordinates(n, node, i, j, k);
+        if (!is_ghost(n, i, j, k)) return;
+        const int kz = k;
+        ghost_source(n, i, j, k);
+        const std::size_t s = index(i, j, k);
+        if (extrapolate_z && kz != k && n[2] > 1) {
+            const int inner = kz < 0 ? 1 : int(n[2]) - 2;
+            f[node] = f[s] + (f[s] - f[index(i, j, inner)]);
+        } else {
+            f[node] = f[s];
+        }
+    }
+    SPHERE_HD std::size_t index(int i, int j, int k) const
+    {
+        return (std::size_t(k + 1) * (n[1] + 2) + std::size_t(j + 1)) * (n[0] + 2) + std::size_t(i + 1);
+    }
+};
+
+/// Fills the ghost faces of the three face-velocity fields and sets the z faces at the top and
+/// bottom of the grid: zero on a no-flow wall, a copy of the adjacent inner face at a
+/// prescribed-pressure end. Tangential components are copied from the nearest cell in z (no
+/// shear stress at the ends: free slip).
+template <class Real>
+struct fill_velocity_ghosts {
+    unsigned n[3];
+    Real* u[3];
+    bool wall_bottom, wall_top;
+
+    SPHERE_HD std::size_t index(int i, int j, int k) const
+    {
+        return (std::size_t(k + 1) * (n[1] + 2) + std::size_t(j + 1)) * (n[0] + 2) + std::size_t(i + 1);
+    }
+    SPHERE_HD void operator()(std::size_t node) const
+    {
+        int i, j, k;
+        field_coordinates(n, node, i, j, k);
+        const int nz = int(n[2]);
+        // z faces: k = -1 and nz - 1 are the ends of the grid, nz lies beyond.
+        if (k == -1 || k >= nz - 1) {
+            int si = i, sj = j, sk = k;
+            ghost_source(n, si, sj, sk);
+            const bool bottom = k == -1;
+            const bool wall = bottom ? wall_bottom : wall_top;
+            const int inner = bottom ? 0 : nz - 2;
+            u[2][node] = (wall || nz < 2) ? Real(0) : u[2][index(si, sj, inner)];
+        } else if (is_ghost(n, i, j, k)) {
+            int si = i, sj = j, sk = k;
+            ghost_source(n, si, sj, sk);
+            u[2][node] = u[2][index(si, sj, sk)];
+        }
+        if (is_ghost(n, i, j, k)) {
+            ghost_source(n, i, j, k);
+            const std::size_t s = index(i, j, k);
+            u[0][node] = u[0][s];
+            u[1][node] = u[1][s];
+        }
+    }
+};
+
+/// The predicted velocity v* on every active face (seeds eq. for v*, docs/fluid.md (F-3)):
+///   v*_a = v_a + dt [ -beta/(rho phi_f) d_a p + 1/(rho phi_f) (div(phi tau))_a
+///                     + F_a/(rho phi_f) + g_a - v_a (dphi/dt)_f / phi_f - (div(phi v_a v))_a / phi_f ]
+/// with the viscous stress tau_ab = mu (d_b v_a + d_a v_b) and the advective flux phi v_a v_b,
+/// both in conservative form: normal fluxes at cell centres, shear fluxes on cell edges (the
+/// porosity of an edge is the mean of its four cells). F is the force density the particles
+/// exert on the fluid (the mean of the two cells of the face).
+template <class Real>
+struct predict_velocity {
+    fluid_view<Real> f;
+    Real* out[3];
+    Real dt, beta;
+    vec3<Real> g;
+
+    SPHERE_HD void operator()(std::size_t cell) const
+    {
+        int i, j, k;
+        f.grid.coordinates(cell, i, j, k);
+        const long long c = f.at(i, j, k);
+        for (int a = 0; a < 3; ++a) {
+            if (!f.active_face(a, k)) continue;
+            out[a][c] = f.u[a][c] + dt * acceleration(c, a);
+        }
+    }
+
+    SPHERE_HD Real acceleration(long long c, int a) const
+    {
+        const long long sa = f.stride[a];
+        const Real* ua = f.u[a];
+        const Real ha = f.grid.width[a];
+        const Real phi_f = f.phi_face(c, a);
+        Real div_tau = 0, div_flux = 0;
+        // normal stress and flux at the centres of the two cells of the face
+        {
+            const Real phi_hi = f.phi[c + sa], phi_lo = f.phi[c];
+            const Real tau_hi = Real(2) * f.mu * (ua[c + sa] - ua[c]) / ha;
+            const Real tau_lo = Real(2) * f.mu * (ua[c] - ua[c - sa]) / ha;
+            const Real v_hi = Real(0.5) * (ua[c + sa] + ua[c]);
+            const Real v_lo = Real(0.5) * (ua[c] + ua[c - sa]);
+            div_tau += (phi_hi * tau_hi - phi_lo * tau_lo) / ha;
+            div_flux += (phi_hi * v_hi * v_hi - phi_lo * v_lo * v_lo) / ha;
+        }
+        // shear stress and flux on the edges above and below along each other axis b
+        for (int b = 0; b < 3; ++b) {
+            if (b == a) continue;
+            const long long sb = f.stride[b];
+            const Real hb = f.grid.width[b];
+            const Real* ub = f.u[b];
+            const long long lo = c - sb;
+            const Real phi_e_hi = Real(0.25) * (f.phi[c] + f.phi[c + sa] + f.phi[c + sb] + f.phi[c + sa + sb]);
+            const Real phi_e_lo = Real(0.25) * (f.phi[lo] + f.phi[lo + sa] + f.phi[c] + f.phi[c + sa]);
+            const Real tau_hi = f.mu * ((ua[c + sb] - ua[c]) / hb + (ub[c + sa] - ub[c]) / ha);
+            const Real tau_lo = f.mu * ((ua[c] - ua[lo]) / hb + (ub[lo + sa] - ub[lo]) / ha);
+            const Real flux_hi = phi_e_hi * Real(0.25) * (ua[c] + ua[c + sb]) * (ub[c] + ub[c + sa]);
+            const Real flux_lo = phi_e_lo * Real(0.25) * (ua[lo] + ua[c]) * (ub[lo] + ub[lo + sa]);
+            div_tau += (phi_e_hi * tau_hi - phi_e_lo * tau_lo) / hb;
+            div_flux += (flux_hi - flux_lo) / hb;
+        }
+        const Real dp = (f.p[c + sa] - f.p[c]) / ha;
+        const Real force = Real(0.5) * (f.force[c][a] + f.force[c + sa][a]);
+        const Real dphi = Real(0.5) * (f.dphi_dt[c] + f.dphi_dt[c + sa]);
+        return (-beta * dp + div_tau + force) / (f.rho * phi_f) + g[a] - ua[c] * dphi / phi_f - div_flux / phi_f;
+    }
+};
+
+/// Right-hand side of the Poisson equation for epsilon on every cell (docs/fluid.md (F-5)):
+///   b = rho/dt [ div(phi_f v*) + dphi/dt ]
+/// (only the cells that are unknowns of the Poisson problem use it).
+template <class Real>
+struct poisson_rhs {
+    fluid_view<Real> f;
+    const Real* vs[3];
+    Real* b;
+    Real dt;
+
+    SPHERE_HD void operator()(std::size_t cell) const
+    {
+        int i, j, k;
+        f.grid.coordinates(cell, i, j, k);
+        const long long c = f.at(i, j, k);
+        Real div = 0;
+        for (int a = 0; a < 3; ++a) {
+            const long long lo = c - f.stride[a];
+            div += (f.phi_face(c, a) * vs[a][c] - f.phi_face(lo, a) * vs[a][lo]) / f.grid.width[a];
+        }
+        b[c] = f.rho / dt * (div + f.dphi_dt[c]);
+    }
+};
+
+/// Sets epsilon on a prescribed-pressure cell layer to p(t + dt) - beta p(t).
+template <class Real>
+struct set_boundary_increment {
+    fluid_view<Real> f;
+    Real* eps;
+    int k;
+    Real value;  ///< p(t + dt) at the layer
+    Real beta;
+
+    SPHERE_HD void operator()(std::size_t column) const
+    {
+        const int i = int(column % f.grid.n[0]), j = int(column / f.grid.n[0]);
+        const long long c = f.at(i, j, k);
+        eps[c] = value - beta * f.p[c];
+    }
+};
+
+/// The projection (docs/fluid.md (F-6)): v = v* - dt/(rho phi_f) d_a epsilon on every active
+/// face, and p = beta p + epsilon on every cell.
+template <class Real>
+struct correct_velocity {
+    fluid_view<Real> f;
+    const Real* vs[3];
+    const Real* eps;
+    Real dt, beta;
+
+    SPHERE_HD void operator()(std::size_t cell) const
+    {
+        int i, j, k;
+        f.grid.coordinates(cell, i, j, k);
+        const long long c = f.at(i, j, k);
+        for (int a = 0; a < 3; ++a) {
+            if (!f.active_face(a, k)) continue;
+            const Real grad = (eps[c + f.stride[a]] - eps[c]) / f.grid.width[a];
+            f.u[a][c] = vs[a][c] - dt / (f.rho * f.phi_face(c, a)) * grad;
+        }
+        f.p[c] = beta * f.p[c] + eps[c];
+    }
+};
+
+/// Copies a porosity estimate (cells) into the solver's fields.
+template <class Real>
+struct copy_porosity {
+    fluid_view<Real> f;
+    porosity_view<Real> in;
+
+    SPHERE_HD void operator()(std::size_t cell) const
+    {
+        int i, j, k;
+        f.grid.coordinates(cell, i, j, k);
+        const std::size_t c = f.grid.field_index(i, j, k);
+        f.phi[c] = in.phi[c];
+        f.dphi_dt[c] = in.dphi_dt[c];
+    }
+};
+
+/// |v_x|/dx + |v_y|/dy + |v_z|/dz at the centre of a cell (1/s), for the advective time-step limit.
+template <class Real>
+struct advective_rate {
+    fluid_view<Real> f;
+    SPHERE_HD Real operator()(std::size_t cell) const
+    {
+        int i, j, k;
+        f.grid.coordinates(cell, i, j, k);
+        const long long c = f.at(i, j, k);
+        Real r = 0;
+        for (int a = 0; a < 3; ++a) {
+            const Real hi = f.u[a][c], lo = f.u[a][c - f.stride[a]];
+            const Real m = (hi < 0 ? -hi : hi) > (lo < 0 ? -lo : lo) ? (hi < 0 ? -hi : hi) : (lo < 0 ? -lo : lo);
+            r += m / f.grid.width[a];
+        }
+        return r;
+    }
+};
+
+/// Smallest porosity of a cell.
+template <class Real>
+struct cell_porosity {
+    fluid_view<Real> f;
+    SPHERE_HD Real operator()(std::size_t cell) const
+    {
+        int i, j, k;
+        f.grid.coordinates(cell, i, j, k);
+        return f.phi[f.at(i, j, k)];
+    }
+};
+
+/// x, y or z momentum per unit density of the face control volume of a cell: phi_f v_a V_cell.
+template <class Real>
+struct face_momentum {
+    fluid_view<Real> f;
+    int a;
+    SPHERE_HD double operator()(std::size_t cell) const
+    {
+        int i, j, k;
+        f.grid.coordinates(cell, i, j, k);
+        if (!f.active_face(a, k)) return 0;
+        const long long c = f.at(i, j, k);
+        return double(f.phi_face(c, a)) * double(f.u[a][c]);
+    }
+};
+
+} // namespace detail
+
+/// The pore-fluid solver. `Poisson` is the pressure solver (jacobi_poisson or
+/// conjugate_gradient_poisson, same interface).
+///
+/// Each `step(dt)` advances the fluid from t to t + dt with the porosity, its rate and the
+/// interaction force it was last given (set_porosity, interaction_force): a fluid on its own
+/// has phi = 1 and no force. The step throws sphere::error, before changing any field, when
+/// dt is not positive, when dt exceeds the diffusive limit dt <= phi_min rho / (2 mu sum 1/h^2)
+/// or the advective limit dt max(|v_x|/dx + |v_y|/dy + |v_z|/dz) <= 1, and after the pressure
+/// solve when it did not converge within the iteration limit.
+template <class Real, class Policy, class Poisson = jacobi_poisson<Real, Policy>>
+class navier_stokes {
+public:
+    navier_stokes(const fluid_grid<Real>& g, const fluid_params<Real>& params)
+        : grid_(g), params_(params), p_(g.field_size(), Real(0)), eps_(g.field_size(), Real(0)),
+          rhs_(g.field_size(), Real(0)), phi_(g.field_size(), Real(1)), dphi_(g.field_size(), Real(0)),
+          force_(g.field_size(), vec3<Real>{0, 0, 0}), poisson_(g)
+    {
+        params_.validate();
+        const bool pressure_end = params_.bottom.kind == fluid_boundary_kind::pressure ||
+                                  params_.top.kind == fluid_boundary_kind::pressure;
+        if (pressure_end && g.n[2] < 3)
+            detail::fail("fluid: nz = ", g.n[2], " cells; a prescribed-pressure end needs nz >= 3");
+        for (int a = 0; a < 3; ++a) {
+            u_[a] = buffer<Real, Policy>(g.field_size(), Real(0));
+            us_[a] = buffer<Real, Policy>(g.field_size(), Real(0));
+        }
+        set_boundary_pressure(0.0);
+        fill_pressure_ghosts();
+    }
+
+    const fluid_grid<Real>& grid() const { return grid_; }
+    const fluid_params<Real>& params() const { return params_; }
+    double time() const { return time_; }
+    /// Result of the last pressure solve (iterations, residual).
+    const poisson_result& last_solve() const { return last_solve_; }
+
+    fluid_view<Real> view()
+    {
+        fluid_view<Real> v;
+        v.grid = grid_;
+        v.p = p_.data();
+        for (int a = 0; a < 3; ++a) v.u[a] = u_[a].data();
+        v.phi = phi_.data();
+        v.dphi_dt = dphi_.data();
+        v.force = force_.data();
+        v.stride[0] = 1;
+        v.stride[1] = grid_.n[0] + 2;
+        v.stride[2] = (long long)(grid_.n[0] + 2) * (grid_.n[1] + 2);
+        v.rho = params_.density;
+        v.mu = params_.viscosity;
+        v.wall_bottom = params_.bottom.kind == fluid_boundary_kind::no_flow;
+        v.wall_top = params_.top.kind == fluid_boundary_kind::no_flow;
+        return v;
+    }
+
+    /// Takes the porosity and its rate from an estimator (same grid). Throws when a cell's
+    /// porosity is not in (0, 1].
+    void set_porosity(const porosity_view<Real>& in)
+    {
+        for (int a = 0; a < 3; ++a)
+            if (in.grid.n[a] != grid_.n[a])
+                detail::fail("fluid: the porosity grid has ", in.grid.n[a], " cells along axis ", a, ", the fluid grid ",
+                             grid_.n[a]);
+        for_each_index(Policy{}, grid_.cell_count(), detail::copy_porosity<Real>{view(), in});
+        const Real lowest = transform_reduce(Policy{}, grid_.cell_count(), detail::cell_porosity<Real>{view()},
+                                             Real(1), min_op{});
+        if (!(lowest > Real(0)))
+            detail::fail("fluid: a cell has porosity ", lowest, "; the fluid needs porosity in (0, 1] everywhere");
+        fill_cell_ghosts(phi_, false);
+        fill_cell_ghosts(dphi_, false);
+    }
+
+    /// The interaction force density on the fluid (N/m^3), one vec3 per cell in field layout,
+    /// in the policy's memory; zero until written. The coupling writes it before each step.
+    vec3<Real>* interaction_force() { return force_.data(); }
+
+    /// Sets the fluid velocity: v(x) for each face centre of each component (host function).
+    template <class Field>
+    void set_velocity(const Field& v)
+    {
+        for (int a = 0; a < 3; ++a) {
+            std::vector<Real> h(grid_.field_size(), Real(0));
+            for (int k = 0; k < int(grid_.n[2]); ++k)
+                for (int j = 0; j < int(grid_.n[1]); ++j)
+                    for (int i = 0; i < int(grid_.n[0]); ++i) {
+                        vec3<Real> x = grid_.centre(i, j, k);
+                        x[a] += Real(0.5) * grid_.width[a];
+                        h[grid_.field_index(i, j, k)] = v(x)[a];
+                    }
+            u_[a].assign(h);
+        }
+        fill_velocity_ghosts();
+    }
+
+    /// Host copies: pressure (Pa), and the velocity component a on its faces (m/s), field layout.
+    std::vector<Real> pressure() const { return p_.to_host(); }
+    std::vector<Real> face_velocity(int a) const { return u_[a].to_host(); }
+    std::vector<Real> porosity() const { return phi_.to_host(); }
+
+    /// The fluid velocity at each cell centre (m/s; the mean of the two faces per axis), field layout.
+    std::vector<vec3<Real>> cell_velocity() const
+    {
+        std::vector<Real> h[3] = {u_[0].to_host(), u_[1].to_host(), u_[2].to_host()};
+        std::vector<vec3<Real>> out(grid_.field_size(), vec3<Real>{0, 0, 0});
+        const long long stride[3] = {1, (long long)grid_.n[0] + 2, (long long)(grid_.n[0] + 2) * (grid_.n[1] + 2)};
+        for (int k = 0; k < int(grid_.n[2]); ++k)
+            for (int j = 0; j < int(grid_.n[1]); ++j)
+                for (int i = 0; i < int(grid_.n[0]); ++i) {
+                    const std::size_t c = grid_.field_index(i, j, k);
+                    for (int a = 0; a < 3; ++a) out[c][a] = Real(0.5) * (h[a][c] + h[a][c - stride[a]]);
+                }
+        return out;
+    }
+
+    /// Momentum of the fluid (kg m/s): rho sum over the faces of phi_f v_a V_cell.
+    vec3<double> momentum()
+    {
+        vec3<double> m{0, 0, 0};
+        const double scale = double(params_.density) * double(grid_.width.x) * grid_.width.y * grid_.width.z;
+        for (int a = 0; a < 3; ++a)
+            m[a] = scale * transform_reduce(Policy{}, grid_.cell_count(), detail::face_momentum<Real>{view(), a}, 0.0,
+                                            plus_op{});
+        return m;
+    }
+
+    /// The largest stable time step (s) for the current velocity and porosity: the smaller of
+    /// the diffusive limit phi_min rho / (2 mu (1/dx^2 + 1/dy^2 + 1/dz^2)) and the advective limit
+    /// 1 / max(|v_x|/dx + |v_y|/dy + |v_z|/dz).
+    Real stable_time_step()
+    {
+        const Real phi_min = transform_reduce(Policy{}, grid_.cell_count(), detail::cell_porosity<Real>{view()},
+                                              Real(1), min_op{});
+        Real inv_h2 = 0;
+        for (int a = 0; a < 3; ++a) inv_h2 += Real(1) / (grid_.width[a] * grid_.width[a]);
+        Real limit = phi_min * params_.density / (Real(2) * params_.viscosity * inv_h2);
+        const Real rate = transform_reduce(Policy{}, grid_.cell_count(), detail::advective_rate<Real>{view()}, Real(0),
+                                           max_op{});
+        if (rate > 0 && Real(1) / rate < limit) limit = Real(1) / rate;
+        return limit;
+    }
+
+    /// Advances the fluid by dt (s); see the class comment for what it checks.
+    void step(Real dt)
+    {
+        if (!(dt > 0) || !std::isfinite(dt)) detail::fail("fluid: time step dt = ", dt, " s must be positive and finite");
+        const Real limit = stable_time_step();
+        if (!(dt <= limit))
+            detail::fail("fluid: time step dt = ", dt, " s exceeds the stability limit ", limit,
+                         " s (diffusive phi rho h^2/(6 mu) or advective h/|v|); reduce dt or coarsen the grid");
+        for_each_index(Policy{}, grid_.field_size(),
+                       detail::fill_cell_ghosts<vec3<Real>>{{grid_.n[0], grid_.n[1], grid_.n[2]}, force_.data(), false});
+        const fluid_view<Real> f = view();
+        Real* out[3] = {us_[0].data(), us_[1].data(), us_[2].data()};
+        for_each_index(Policy{}, grid_.cell_count(),
+                       detail::predict_velocity<Real>{f, {out[0], out[1], out[2]}, dt, params_.beta, params_.gravity});
+        fill_velocity_ghosts(out);
+        const Real* vs[3] = {out[0], out[1], out[2]};
+        for_each_index(Policy{}, grid_.cell_count(), detail::poisson_rhs<Real>{f, {vs[0], vs[1], vs[2]}, rhs_.data(), dt});
+        set_boundary_increment(time_ + double(dt));
+        poisson_boundaries bc;
+        bc.bottom = params_.bottom.kind == fluid_boundary_kind::pressure ? z_boundary::dirichlet : z_boundary::neumann;
+        bc.top = params_.top.kind == fluid_boundary_kind::pressure ? z_boundary::dirichlet : z_boundary::neumann;
+        last_solve_ = poisson_.solve(eps_.data(), rhs_.data(), bc, params_.poisson);
+        if (!last_solve_.converged)
+            detail::fail("fluid: the pressure solve did not converge at t = ", time_, " s: residual ",
+                         last_solve_.residual, " after ", last_solve_.iterations, " iterations (tolerance ",
+                         params_.poisson.tolerance, "); raise fluid_params::poisson.max_iterations or reduce dt");
+        for_each_index(Policy{}, grid_.cell_count(),
+                       detail::correct_velocity<Real>{f, {vs[0], vs[1], vs[2]}, eps_.data(), dt, params_.beta});
+        fill_velocity_ghosts();
+        fill_pressure_ghosts();
+        time_ += double(dt);
+    }
+
+private:
+    void fill_cell_ghosts(buffer<Real, Policy>& b, bool extrapolate_z)
+    {
+        for_each_index(Policy{}, grid_.field_size(),
+                       detail::fill_cell_ghosts<Real>{{grid_.n[0], grid_.n[1], grid_.n[2]}, b.data(), extrapolate_z});
+    }
+    void fill_pressure_ghosts() { fill_cell_ghosts(p_, true); }
+    void fill_velocity_ghosts(Real* const* u)
+    {
+        const fluid_view<Real> f = view();
+        for_each_index(Policy{}, grid_.field_size(),
+                       detail::fill_velocity_ghosts<Real>{{grid_.n[0], grid_.n[1], grid_.n[2]},
+                                                         {u[0], u[1], u[2]},
+                                                         f.wall_bottom,
+                                                         f.wall_top});
+    }
+    void fill_velocity_ghosts()
+    {
+        Real* u[3] = {u_[0].data(), u_[1].data(), u_[2].data()};
+        fill_velocity_ghosts(u);
+    }
+
+    /// On the prescribed-pressure layers: epsilon = p(t) - beta p, with p the current pressure
+    /// there (called with t = time + dt before the solve); at construction (beta irrelevant,
+    /// p = 0) it also sets the layer's pressure to p(0).
+    void set_boundary_increment(double t)
+    {
+        const fluid_view<Real> f = view();
+        const std::size_t columns = std::size_t(grid_.n[0]) * grid_.n[1];
+        if (params_.bottom.kind == fluid_boundary_kind::pressure)
+            for_each_index(Policy{}, columns,
+                           detail::set_boundary_increment<Real>{f, eps_.data(), 0, params_.bottom.value(t), params_.beta});
+        if (params_.top.kind == fluid_boundary_kind::pressure)
+            for_each_index(Policy{}, columns,
+                           detail::set_boundary_increment<Real>{f, eps_.data(), int(grid_.n[2]) - 1,
+                                                                 params_.top.value(t), params_.beta});
+    }
+    void set_boundary_pressure(double t)
+    {
+        set_boundary_increment(t);
+        const fluid_view<Real> f = view();
+        const std::size_t columns = std::size_t(grid_.n[0]) * grid_.n[1];
+        // p = 0 here, so epsilon on the layers is p(t): copy it into the pressure.
+        if (params_.bottom.kind == fluid_boundary_kind::pressure)
+            for_each_index(Policy{}, columns,
+                           detail::set_boundary_increment<Real>{f, p_.data(), 0, params_.bottom.value(t), Real(0)});
+        if (params_.top.kind == fluid_boundary_kind::pressure)
+            for_each_index(Policy{}, columns,
+                           detail::set_boundary_increment<Real>{f, p_.data(), int(grid_.n[2]) - 1,
+                                                                 params_.top.value(t), Real(0)});
+    }
+
+    fluid_grid<Real> grid_;
+    fluid_params<Real> params_;
+    buffer<Real, Policy> u_[3], us_[3];
+    buffer<Real, Policy> p_, eps_, rhs_, phi_, dphi_;
+    buffer<vec3<Real>, Policy> force_;
+    Poisson poisson_;
+    poisson_result last_solve_{};
+    double time_ = 0;
+};
+
+} // namespace sphere

@@ -1,0 +1,745 @@
+#pragma once
+/// \file
+/// The pressure-Poisson problem of the projection step and its Jacobi solver
+/// (docs/fluid.md, *Pressure Poisson solvers*); the faster conjugate-gradient solver with the
+/// same interface is in poisson_cg.cuh.
+///
+/// **The discrete problem.** The unknown eps lives on the cells (i, j, k), 0 <= i < nx,
+/// 0 <= j < ny, 0 <= k < nz, of a fluid_grid<Real>, stored in a field with ghost nodes
+/// (`grid.field_index(i, j, k)`, each coordinate in [-1, n]). On every unknown cell it obeys
+/// the compact 7-point Laplacian
+///
+///     (e[i+1,j,k] - 2 e[i,j,k] + e[i-1,j,k]) / dx^2
+///   + (e[i,j+1,k] - 2 e[i,j,k] + e[i,j-1,k]) / dy^2
+///   + (e[i,j,k+1] - 2 e[i,j,k] + e[i,j,k-1]) / dz^2  =  b[i,j,k]
+///
+/// with dx, dy, dz the cell widths (m) and b the right-hand side field (same layout; for the
+/// projection step eps is a pressure in Pa and b is in Pa/m^2). Boundaries:
+///   - x and y are always periodic (as in the seeds, whatever the world box's axis types):
+///     neighbour -1 is cell n - 1 and neighbour n is cell 0;
+///   - each end of z is a `z_boundary`:
+///       dirichlet: the whole cell layer k = 0 (bottom) or k = nz - 1 (top) is not an unknown:
+///         it holds a prescribed value, given in eps on entry and never changed by the solver
+///         (the Dirichlet value sits at that cell's centre). Needs nz >= 3.
+///       neumann: the ghost layer k = -1 (or nz) equals the adjacent cell k = 0 (or nz - 1):
+///         zero normal gradient at the wall face, so that row's z term is
+///         (e[k+1] - e[k]) / dz^2 (bottom) or (e[k-1] - e[k]) / dz^2 (top).
+///
+/// **Singular case.** With Neumann at both ends (and periodic x, y) the operator annihilates
+/// constants: b must have zero mean for a solution to exist, and a solution is defined up to a
+/// constant. The solvers then solve the compatible problem with b replaced by b - mean(b) (the
+/// mean over the cells; rhs itself is not modified; this is the least-squares solution), and
+/// return the solution with zero mean over the cells (to round-off).
+///
+/// **On return** every ghost node of eps is filled consistently with the boundaries, so
+/// callers can take centred differences anywhere: on x and y the periodic copies; on a Neumann
+/// end the copy of the adjacent cell; on a Dirichlet end the linear extrapolation
+/// e[-1] = 2 e[0] - e[1] (top: e[nz] = 2 e[nz-1] - e[nz-2]), which makes the centred gradient
+/// at the Dirichlet cell the one-sided (e[1] - e[0]) / dz. Edge and corner ghosts combine the
+/// rules (a z ghost of a periodic column is the z ghost of the wrapped column).
+///
+/// **Stopping criteria** (`poisson_criterion`):
+///   - relative_residual (default): ||b - A eps||_2 / ||b_u||_2 over the unknowns, where b_u is
+///     the right-hand side of the system for the unknowns: b (after the mean removal in the
+///     singular case) minus the stencil terms that reach into a Dirichlet layer (so that a
+///     problem driven by its boundary values alone, b = 0, is measured against them rather
+///     than against round-off in b); evaluated in double precision whatever Real is; the
+///     absolute residual ||b - A eps||_2 when ||b_u||_2 = 0 (so a fluid at rest, b = 0 and
+///     eps = 0, gives exactly 0). It bounds the error of the solution
+///     (||error|| <= ||A^-1|| ||b|| x residual). Precision: eps is stored in Real, and merely
+///     rounding the exact solution to Real leaves a relative residual of about
+///     epsilon_Real x (2/dx^2 + 2/dy^2 + 2/dz^2) max|eps| / rms(b); in float that is 1e-6 to
+///     1e-4 (64^3 with a Dirichlet top and a right-hand side of non-zero mean: 1e-4), so a
+///     float solve needs a tolerance above that floor, or it runs to max_iterations and
+///     returns converged = false. The default 1e-8 is meant for double.
+///   - normalized_change (the seeds' "normalized residual"): the largest over the unknowns of
+///     (eps_new - eps_old)^2 / eps_new^2 between consecutive iterates. A cell with
+///     eps_new = 0 and no change contributes 0; a cell with eps_new = 0 that changed uses the
+///     largest eps_new^2 of the field as denominator (1 if the whole field is 0). The seeds
+///     divided 0 by 0 there and produced NaN for a fluid at rest. This measures stagnation,
+///     not accuracy: a slowly converging iteration makes small changes long before it is
+///     close to the solution, and the value depends on the offset of eps.
+/// Before the first iteration the criterion is evaluated on the initial guess (for
+/// normalized_change: whether the true residual is exactly 0); if it is met, solve returns
+/// iterations = 0 and converged = true. A solve that reaches max_iterations returns
+/// converged = false with the iteration count and the last residual; it does not throw: the
+/// caller decides (the projection step may accept the iterate, warn, or stop).
+///
+/// **Errors** (sphere::error): tolerance <= 0 or not finite, max_iterations = 0, nz < 3 with a
+/// Dirichlet end, and a residual that becomes NaN or infinite (NaN/inf input or divergence).
+///
+/// **Determinism.** Every kernel writes only its own cells, and every reduction has a fixed
+/// association order: on the host, fixed groups of whole rows are summed in order (in
+/// parallel over groups) and the group sums in order, independent of the thread count; on
+/// the GPU through transform_reduce (CUB, run-to-run deterministic). The same input on the
+/// same backend gives bit-identical output (on the host, for any number of threads).
+#include <cmath>
+#include <cstddef>
+#include <type_traits>
+#include <vector>
+
+#include "../core/config.cuh"
+#include "../core/error.cuh"
+#include "../exec/algorithms.cuh"
+#include "../exec/buffer.cuh"
+#include "../exec/for_each.cuh"
+#include "grid.cuh"
+
+namespace sphere {
+
+/// The condition at one end (bottom, k = 0, or top, k = nz - 1) of the z axis of a Poisson
+/// problem (see the file comment).
+enum class z_boundary {
+    dirichlet, ///< the end cell layer holds a prescribed value (in eps on entry) and is no unknown
+    neumann,   ///< zero normal gradient: the ghost layer equals the end cell layer
+};
+
+/// The z boundaries of a Poisson problem; x and y are always periodic.
+struct poisson_boundaries {
+    z_boundary bottom = z_boundary::neumann; ///< at k = 0
+    z_boundary top = z_boundary::neumann;    ///< at k = nz - 1
+};
+
+/// How a solver decides that it has converged (see the file comment).
+enum class poisson_criterion {
+    relative_residual, ///< ||b - A eps||_2 / ||b||_2 <= tolerance (absolute when b = 0)
+    normalized_change, ///< max (eps_new - eps_old)^2 / eps_new^2 <= tolerance (the seeds')
+};
+
+/// Settings of one solve.
+struct poisson_settings {
+    double tolerance = 1e-8;          ///< threshold of the criterion; positive and finite
+    unsigned max_iterations = 100000; ///< at least 1; reaching it returns converged = false
+    poisson_criterion criterion = poisson_criterion::relative_residual;
+};
+
+/// What a solve did.
+struct poisson_result {
+    unsigned iterations = 0; ///< iterations applied to the returned eps (0: the guess was accepted)
+    double residual = 0;     ///< the criterion's value for the returned eps (relative_residual)
+                             ///< or for the last iteration (normalized_change)
+    bool converged = false;  ///< residual <= tolerance
+};
+
+namespace detail {
+
+/// Geometry of a Poisson problem for the kernels: the grid, the unknown cell layers
+/// k_first .. k_first + k_count - 1 (all nz layers but the Dirichlet ones), the field strides
+/// and the stencil coefficients 1/dx^2, 1/dy^2, 1/dz^2 (1/m^2).
+template <class Real>
+struct poisson_stencil {
+    fluid_grid<Real> grid;
+    int k_first;                ///< first unknown layer: 1 with a Dirichlet bottom, else 0
+    int k_count;                ///< number of unknown layers
+    bool bottom_dirichlet;
+    bool top_dirichlet;
+    std::size_t sy, sz;         ///< field strides along y and z (x: 1)
+    double cx, cy, cz;          ///< 1/dx^2, 1/dy^2, 1/dz^2 (1/m^2)
+
+    /// Number of unknown cells.
+    SPHERE_HD std::size_t unknowns() const { return std::size_t(grid.n[0]) * grid.n[1] * std::size_t(k_count); }
+
+    /// Number of rows of unknowns along x (one per unknown (j, k)).
+    SPHERE_HD std::size_t rows() const { return std::size_t(grid.n[1]) * std::size_t(k_count); }
+
+    /// Field index of the first cell (i = 0) of row r (y fastest, then the unknown layers).
+    SPHERE_HD std::size_t row_start(std::size_t r) const
+    {
+        return grid.field_index(0, static_cast<int>(r % grid.n[1]), static_cast<int>(r / grid.n[1]) + k_first);
+    }
+
+    /// Field index of unknown u (x fastest, then y, then the unknown layers).
+    SPHERE_HD std::size_t field(std::size_t u) const
+    {
+        const int i = static_cast<int>(u % grid.n[0]);
+        u /= grid.n[0];
+        const int j = static_cast<int>(u % grid.n[1]);
+        const int k = static_cast<int>(u / grid.n[1]) + k_first;
+        return grid.field_index(i, j, k);
+    }
+
+    /// (A e) at field index f, in double, from a field whose ghosts are filled.
+    SPHERE_HD double laplacian(const Real* e, std::size_t f) const
+    {
+        const double c = double(e[f]);
+        return cx * ((double(e[f - 1]) - c) + (double(e[f + 1]) - c)) +
+               cy * ((double(e[f - sy]) - c) + (double(e[f + sy]) - c)) +
+               cz * ((double(e[f - sz]) - c) + (double(e[f + sz]) - c));
+    }
+};
+
+/// Fills every ghost node of a field from its cells (see the file comment): periodic copies
+/// on x and y, a copy of the end cell on a Neumann end, 2 e[0] - e[1] on a Dirichlet end. The
+/// ghost nodes are numbered g = 0 .. count - 1 as: the two z ghost planes (k = -1, nz; all i, j in
+/// [-1, n]), then for each layer k in [0, nz) the two y ghost rows (j = -1, ny; all i), then
+/// for each (j, k) in the cells the two x ghosts. Ghosts are computed from cells only, so
+/// they are independent. Each index of the loop fills `per_index` consecutive ghosts (host: see
+/// host_cells_per_index; 1 on the GPU).
+template <class Real>
+struct fill_poisson_ghosts {
+    poisson_stencil<Real> s;
+    Real* e;
+    std::size_t per_index;
+    std::size_t count; ///< number of ghost nodes
+
+    SPHERE_HD void operator()(std::size_t index) const
+    {
+        const std::size_t first = index * per_index, end = first + per_index < count ? first + per_index : count;
+        for (std::size_t g = first; g < end; ++g) fill(g);
+    }
+
+    SPHERE_HD static int wrap(int i, int n) { return i < 0 ? n - 1 : (i >= n ? 0 : i); }
+
+    SPHERE_HD void fill(std::size_t g) const
+    {
+        const int nx = static_cast<int>(s.grid.n[0]), ny = static_cast<int>(s.grid.n[1]),
+                  nz = static_cast<int>(s.grid.n[2]);
+        const std::size_t row = std::size_t(nx) + 2, plane = row * (std::size_t(ny) + 2);
+        int i, j, k;
+        if (g < 2 * plane) {
+            k = g < plane ? -1 : nz;
+            const std::size_t r = g % plane;
+            i = static_cast<int>(r % row) - 1;
+            j = static_cast<int>(r / row) - 1;
+        } else if (g - 2 * plane < 2 * row * std::size_t(nz)) {
+            const std::size_t h = g - 2 * plane;
+            k = static_cast<int>(h / (2 * row));
+            const std::size_t r = h % (2 * row);
+            j = r < row ? -1 : ny;
+            i = static_cast<int>(r % row) - 1;
+        } else {
+            const std::size_t h = g - 2 * plane - 2 * row * std::size_t(nz);
+            k = static_cast<int>(h / (2 * std::size_t(ny)));
+            const std::size_t r = h % (2 * std::size_t(ny));
+            j = static_cast<int>(r / 2);
+            i = (r % 2) ? nx : -1;
+        }
+        const int si = wrap(i, nx), sj = wrap(j, ny);
+        Real v;
+        if (k == -1) {
+            const Real e0 = e[s.grid.field_index(si, sj, 0)];
+            v = s.bottom_dirichlet ? Real(2) * e0 - e[s.grid.field_index(si, sj, 1)] : e0;
+        } else if (k == nz) {
+            const Real e0 = e[s.grid.field_index(si, sj, nz - 1)];
+            v = s.top_dirichlet ? Real(2) * e0 - e[s.grid.field_index(si, sj, nz - 2)] : e0;
+        } else {
+            v = e[s.grid.field_index(si, sj, k)];
+        }
+        e[s.grid.field_index(i, j, k)] = v;
+    }
+};
+
+/// The singular case's mean of b, removed from b: the unevaluated sum hi + lo, where hi is the
+/// mean of b over the cells and lo the mean of b - hi (0 and 0 outside the singular case).
+/// A single double cannot hold the mean of a right-hand side whose mean is much larger than
+/// its variations (a fluid's b: ~2e3 Pa/m^2 with variations of ~1e-7): b - hi keeps a
+/// constant of up to ulp(hi) / 2 per cell, which A cannot remove (A annihilates constants),
+/// so the residual could never fall below ~ulp(hi) / rms(b - hi) relative (1e-6 there).
+/// (b - hi) - lo is zero-mean to the round-off of b - hi, which is exact when b is within a
+/// factor 2 of hi.
+struct poisson_shift {
+    double hi = 0;
+    double lo = 0;
+
+    SPHERE_HD double from(double b) const { return (b - hi) - lo; }
+};
+
+/// (b - shift - A e)^2 at cell f, in double; e with filled ghosts. Summed: ||b - A e||^2.
+template <class Real>
+struct poisson_residual_squared {
+    poisson_stencil<Real> s;
+    const Real* e;
+    const Real* b;
+    poisson_shift shift; ///< mean of b in the singular case, else 0
+
+    SPHERE_HD double operator()(std::size_t f) const
+    {
+        const double r = shift.from(double(b[f])) - s.laplacian(e, f);
+        return r * r;
+    }
+};
+
+/// (b - shift - known)^2 at cell f, in double, where `known` are the terms of the stencil that
+/// reach into a Dirichlet layer (cz times its value): the right-hand side of the system for the
+/// unknowns. Summed: its squared norm, the scale of the relative residual, so that a problem
+/// driven by its boundary values alone (b = 0, as a pressure difference between two
+/// prescribed layers) is measured against them and not against round-off in b.
+template <class Real>
+struct poisson_rhs_squared {
+    poisson_stencil<Real> s;
+    const Real* e; ///< holds the Dirichlet values
+    const Real* b;
+    poisson_shift shift;
+
+    SPHERE_HD double operator()(std::size_t f) const
+    {
+        double v = shift.from(double(b[f]));
+        const int k = static_cast<int>(f / s.sz) - 1;
+        if (s.bottom_dirichlet && k == s.k_first) v -= s.cz * double(e[f - s.sz]);
+        if (s.top_dirichlet && k == s.k_first + s.k_count - 1) v -= s.cz * double(e[f + s.sz]);
+        return v * v;
+    }
+};
+
+/// The value of a cell of a field, in double. Summed over the cells: their sum.
+template <class Real>
+struct field_cell_value {
+    const Real* v;
+    SPHERE_HD double operator()(std::size_t f) const { return double(v[f]); }
+};
+
+/// The value of a cell of a field minus `offset`, in double. Summed over the cells: their sum.
+template <class Real>
+struct field_cell_offset {
+    const Real* v;
+    double offset;
+    SPHERE_HD double operator()(std::size_t f) const { return double(v[f]) - offset; }
+};
+
+/// v -= value on a cell.
+template <class Real>
+struct subtract_from_cells {
+    Real* v;
+    Real value;
+    SPHERE_HD void operator()(std::size_t f) const { v[f] -= value; }
+};
+
+/// dst[i] = src[i].
+template <class Real>
+struct copy_values {
+    const Real* src;
+    Real* dst;
+    SPHERE_HD void operator()(std::size_t i) const { dst[i] = src[i]; }
+};
+
+/// v[i] = value.
+template <class Real>
+struct set_values {
+    Real* v;
+    Real value;
+    SPHERE_HD void operator()(std::size_t i) const { v[i] = value; }
+};
+
+/// Ingredients of the normalized change, combined by `normalized_change_max` into
+/// max(ratio, zero_change2 / new2) (see normalized_change_value).
+struct normalized_change_parts {
+    double ratio;        ///< largest (new - old)^2 / new^2 over cells with new != 0
+    double new2;         ///< largest new^2
+    double zero_change2; ///< largest (new - old)^2 over cells with new = 0
+};
+
+/// Element-wise maximum of normalized_change_parts; a NaN in either operand wins.
+struct normalized_change_max {
+    SPHERE_HD static double nan_max(double a, double b) { return (a < b || b != b) ? b : a; }
+    SPHERE_HD normalized_change_parts operator()(const normalized_change_parts& a,
+                                                 const normalized_change_parts& b) const
+    {
+        return {nan_max(a.ratio, b.ratio), nan_max(a.new2, b.new2), nan_max(a.zero_change2, b.zero_change2)};
+    }
+};
+
+/// The parts of the normalized change at cell f between the new iterate x and the
+/// previous one: the change is x - old when `old` is given, else step * p (a CG step).
+template <class Real>
+struct normalized_change_at {
+    const Real* x;
+    const Real* old;
+    const Real* p;
+    double step;
+
+    SPHERE_HD normalized_change_parts operator()(std::size_t f) const
+    {
+        const double n = double(x[f]);
+        const double d = old ? n - double(old[f]) : step * double(p[f]);
+        const double n2 = n * n, d2 = d * d;
+        if (n2 > 0) return {d2 / n2, n2, 0.0};
+        return {0.0, 0.0, d2};
+    }
+};
+
+/// The normalized change from its reduced parts: a cell with eps_new = 0 that changed is
+/// measured against the largest eps_new^2 (1 when the whole field is 0). NaN propagates.
+inline double normalized_change_value(const normalized_change_parts& m)
+{
+    if (std::isnan(m.ratio) || std::isnan(m.new2) || std::isnan(m.zero_change2)) return std::nan("");
+    if (m.zero_change2 == 0) return m.ratio;
+    const double zero = m.new2 > 0 ? m.zero_change2 / m.new2 : 1.0;
+    return m.ratio < zero ? zero : m.ratio;
+}
+
+/// One Jacobi sweep on cell f: the classic update of the seeds,
+///   e_new = [dy^2 dz^2 (e_w + e_e) + dx^2 dz^2 (e_s + e_n) + dx^2 dy^2 (e_b + e_t)
+///            - dx^2 dy^2 dz^2 b] / [2 (dx^2 dy^2 + dx^2 dz^2 + dy^2 dz^2)],
+/// evaluated as wx (e_w + e_e) + wy (e_s + e_n) + wz (e_b + e_t) - wb b with the weights
+/// divided through (wx = (1/dx^2) / D, ..., wb = 1 / D, D = 2 (1/dx^2 + 1/dy^2 + 1/dz^2)),
+/// which is the same expression without the dx^6-sized products (float underflow).
+template <class Real>
+struct jacobi_sweep {
+    poisson_stencil<Real> s;
+    Real wx, wy, wz, wb;
+    Real shift;
+    const Real* b;
+    const Real* old;
+    Real* out;
+
+    SPHERE_HD void operator()(std::size_t f) const
+    {
+        out[f] = wx * (old[f - 1] + old[f + 1]) + wy * (old[f - s.sy] + old[f + s.sy]) +
+                 wz * (old[f - s.sz] + old[f + s.sz]) - wb * (b[f] - shift);
+    }
+};
+
+/// Host work unit of the cell loops: whole rows of nx cells along x, at least
+/// `host_cells_per_index` cells per index, so that for_each_index (parallel from
+/// host_parallel_threshold indices) starts threads only from about 32k cells: below that a
+/// sweep takes microseconds, less than starting and joining a team (far less when the cores
+/// are shared).
+inline constexpr std::size_t host_cells_per_index = 128;
+
+/// Rows per host index for rows of nx cells.
+inline std::size_t host_rows_per_index(unsigned nx)
+{
+    return nx >= host_cells_per_index ? 1 : (host_cells_per_index + nx - 1) / nx;
+}
+
+/// Runs the cell kernel k(f) (f a field index) on every cell of the layers of s: on the host
+/// one index per `per_index` consecutive rows of nx cells along x (no integer division per cell,
+/// contiguous inner loops), on the GPU one index per cell (over_cells).
+template <class Real, class Kernel>
+struct over_rows {
+    poisson_stencil<Real> s;
+    Kernel k;
+    std::size_t per_index; ///< rows per index
+
+    SPHERE_HD void operator()(std::size_t g) const
+    {
+        const std::size_t first = g * per_index, last = s.rows(), n = s.grid.n[0];
+        const std::size_t end = first + per_index < last ? first + per_index : last;
+        for (std::size_t r = first; r < end; ++r) {
+            const std::size_t f0 = s.row_start(r);
+            for (std::size_t i = 0; i < n; ++i) k(f0 + i);
+        }
+    }
+};
+
+template <class Real, class Kernel>
+struct over_cells {
+    poisson_stencil<Real> s;
+    Kernel k;
+    SPHERE_HD void operator()(std::size_t u) const { k(s.field(u)); }
+};
+
+/// Writes op(f(first cell), ..., f(last cell)) of the rows of host index g, in order, to out[g].
+template <class Real, class Transform, class T, class Op>
+struct reduce_rows {
+    poisson_stencil<Real> s;
+    Transform f;
+    Op op;
+    std::size_t per_index; ///< rows per index
+    T* out;
+
+    SPHERE_HD void operator()(std::size_t g) const
+    {
+        const std::size_t first = g * per_index, last = s.rows(), n = s.grid.n[0];
+        const std::size_t end = first + per_index < last ? first + per_index : last;
+        T acc = f(s.row_start(first));
+        for (std::size_t r = first; r < end; ++r) {
+            const std::size_t f0 = s.row_start(r);
+            for (std::size_t i = (r == first ? 1 : 0); i < n; ++i) acc = op(acc, f(f0 + i));
+        }
+        out[g] = acc;
+    }
+};
+
+template <class Real, class Transform>
+struct transform_cell {
+    poisson_stencil<Real> s;
+    Transform f;
+    SPHERE_HD auto operator()(std::size_t u) const { return f(s.field(u)); }
+};
+
+template <class Real, class Kernel>
+void for_each_cell(host, const poisson_stencil<Real>& s, const Kernel& k)
+{
+    const std::size_t rows = host_rows_per_index(s.grid.n[0]);
+    for_each_index(host{}, (s.rows() + rows - 1) / rows, over_rows<Real, Kernel>{s, k, rows});
+}
+
+/// init op (f over the cells of the layers of s), deterministic: on the host each index's
+/// rows are reduced in order along x (indices in parallel) and the indices' results in
+/// order; on the GPU through transform_reduce (CUB, run-to-run deterministic). `partial`
+/// is host scratch.
+template <class Real, class T, class Transform, class Op>
+T reduce_cells(host, const poisson_stencil<Real>& s, const Transform& f, T init, Op op, std::vector<T>& partial)
+{
+    const std::size_t rows = host_rows_per_index(s.grid.n[0]), n = (s.rows() + rows - 1) / rows;
+    partial.resize(n);
+    for_each_index(host{}, n, reduce_rows<Real, Transform, T, Op>{s, f, op, rows, partial.data()});
+    T acc = init;
+    for (const T& r : partial) acc = op(acc, r);
+    return acc;
+}
+
+#if SPHERE_CUDA_COMPILER
+template <class Real, class Kernel>
+void for_each_cell(cuda, const poisson_stencil<Real>& s, const Kernel& k)
+{
+    for_each_index(cuda{}, s.unknowns(), over_cells<Real, Kernel>{s, k});
+}
+
+template <class Real, class T, class Transform, class Op>
+T reduce_cells(cuda, const poisson_stencil<Real>& s, const Transform& f, T init, Op op, std::vector<T>&)
+{
+    return transform_reduce(cuda{}, s.unknowns(), transform_cell<Real, Transform>{s, f}, init, op);
+}
+#endif
+
+/// The problem set-up shared by the solvers: the stencil, the boundaries, the host-side
+/// checks and the whole-field operations (ghosts, norms, means).
+template <class Real, class Policy>
+class poisson_problem {
+public:
+    explicit poisson_problem(const fluid_grid<Real>& g) : grid_(g) {}
+
+    const fluid_grid<Real>& grid() const { return grid_; }
+
+    /// Checks the settings and the boundaries against the grid (throws), and sets the stencil.
+    void prepare(const poisson_boundaries& bc, const poisson_settings& st)
+    {
+        if (!(st.tolerance > 0) || !std::isfinite(st.tolerance))
+            fail("Poisson solver: tolerance = ", st.tolerance, " must be positive and finite");
+        if (st.max_iterations == 0) fail("Poisson solver: max_iterations = 0 must be at least 1");
+        const bool bottom = bc.bottom == z_boundary::dirichlet, top = bc.top == z_boundary::dirichlet;
+        if ((bottom || top) && grid_.n[2] < 3)
+            fail("Poisson solver: nz = ", grid_.n[2], " cells is too few for a Dirichlet boundary (",
+                 bottom && top ? "bottom and top" : (bottom ? "bottom" : "top"), "), which needs nz >= 3");
+        s_.grid = grid_;
+        s_.bottom_dirichlet = bottom;
+        s_.top_dirichlet = top;
+        s_.k_first = bottom ? 1 : 0;
+        s_.k_count = static_cast<int>(grid_.n[2]) - (bottom ? 1 : 0) - (top ? 1 : 0);
+        s_.sy = std::size_t(grid_.n[0]) + 2;
+        s_.sz = s_.sy * (std::size_t(grid_.n[1]) + 2);
+        const double dx = double(grid_.width.x), dy = double(grid_.width.y), dz = double(grid_.width.z);
+        s_.cx = 1.0 / (dx * dx);
+        s_.cy = 1.0 / (dy * dy);
+        s_.cz = 1.0 / (dz * dz);
+        all_ = s_;
+        all_.k_first = 0;
+        all_.k_count = static_cast<int>(grid_.n[2]);
+        singular_ = !bottom && !top;
+        shift_ = poisson_shift{};
+    }
+
+    const poisson_stencil<Real>& stencil() const { return s_; }
+    /// The mean of b removed in the singular case (hi + lo), else 0.
+    const poisson_shift& shift() const { return shift_; }
+    /// Neumann at both ends: A annihilates the constants, and every cell is an unknown.
+    bool singular() const { return singular_; }
+
+    /// Runs the cell kernel k(f) on every unknown cell.
+    template <class Kernel>
+    void for_each_unknown(const Kernel& k) const
+    {
+        for_each_cell(Policy{}, s_, k);
+    }
+
+    /// The sum (in double) of the cell transform f(f) over the unknown cells.
+    template <class Transform>
+    double sum_unknowns(const Transform& f)
+    {
+        return reduce_cells(Policy{}, s_, f, 0.0, plus_op{}, row_sums_);
+    }
+
+    /// In the singular case: shift = mean of b over the cells (as hi + lo, see poisson_shift),
+    /// and eps made zero-mean, its ghosts refilled (subtract_mean changes the cells only; stale
+    /// ghosts would keep the old offset in the stencil of the boundary cells).
+    void remove_means(Real* eps, const Real* b)
+    {
+        if (!singular_) return;
+        shift_.hi = cell_mean(b);
+        shift_.lo = reduce_cells(Policy{}, all_, field_cell_offset<Real>{b, shift_.hi}, 0.0, plus_op{}, row_sums_) /
+                    double(grid_.cell_count());
+        subtract_mean(eps);
+        fill_ghosts(eps);
+    }
+
+    void subtract_mean(Real* eps)
+    {
+        const double m = cell_mean(eps);
+        if (m != 0) for_each_cell(Policy{}, all_, subtract_from_cells<Real>{eps, Real(m)});
+    }
+
+    void fill_ghosts(Real* e) const
+    {
+        const std::size_t count = grid_.field_size() - grid_.cell_count();
+        const std::size_t per_index = std::is_same<Policy, host>::value ? host_cells_per_index : 1;
+        for_each_index(Policy{}, (count + per_index - 1) / per_index,
+                       fill_poisson_ghosts<Real>{s_, e, per_index, count});
+    }
+
+    /// ||b - shift - A e||_2 over the unknowns (double); e with filled ghosts.
+    double residual_norm(const Real* e, const Real* b)
+    {
+        return std::sqrt(sum_unknowns(poisson_residual_squared<Real>{s_, e, b, shift_}));
+    }
+
+    /// ||b - shift - known Dirichlet terms||_2 over the unknowns (double); e holds the
+    /// Dirichlet values.
+    double rhs_norm(const Real* e, const Real* b)
+    {
+        return std::sqrt(sum_unknowns(poisson_rhs_squared<Real>{s_, e, b, shift_}));
+    }
+
+    /// The normalized change between x and old (old != nullptr) or of the step step * p.
+    double normalized_change(const Real* x, const Real* old, const Real* p, double step)
+    {
+        return normalized_change_value(reduce_cells(Policy{}, s_, normalized_change_at<Real>{x, old, p, step},
+                                                    normalized_change_parts{0.0, 0.0, 0.0}, normalized_change_max{},
+                                                    row_changes_));
+    }
+
+    /// dst = src on the whole field (cells and ghosts).
+    void copy(const Real* src, Real* dst) const
+    {
+        for_each_index(Policy{}, grid_.field_size(), copy_values<Real>{src, dst});
+    }
+
+    /// v = 0 on the whole field.
+    void zero(Real* v) const { for_each_index(Policy{}, grid_.field_size(), set_values<Real>{v, Real(0)}); }
+
+    /// Throws when a criterion value is NaN or infinite.
+    static void check_finite(double value, unsigned iterations)
+    {
+        if (std::isnan(value))
+            fail("Poisson solver: residual became NaN after ", iterations,
+                 " iterations (a NaN or infinite value in the right-hand side, the Dirichlet values or the "
+                 "initial guess, or divergence)");
+        if (!std::isfinite(value))
+            fail("Poisson solver: residual became infinite after ", iterations,
+                 " iterations (an infinite value in the input, or divergence)");
+    }
+
+    /// The end of a solve: the singular case's zero mean, and the ghosts.
+    void finish(Real* eps)
+    {
+        if (singular_) subtract_mean(eps);
+        fill_ghosts(eps);
+    }
+
+private:
+    double cell_mean(const Real* v)
+    {
+        return reduce_cells(Policy{}, all_, field_cell_value<Real>{v}, 0.0, plus_op{}, row_sums_) /
+               double(grid_.cell_count());
+    }
+
+    fluid_grid<Real> grid_;
+    poisson_stencil<Real> s_{};   ///< the unknown layers
+    poisson_stencil<Real> all_{}; ///< every cell layer
+    bool singular_ = false;
+    poisson_shift shift_{};
+    std::vector<double> row_sums_; ///< host scratch of the reductions
+    std::vector<normalized_change_parts> row_changes_;
+};
+
+} // namespace detail
+
+/// Jacobi iterations for the pressure-Poisson problem (file comment; docs/fluid.md), as in the
+/// seeds: every sweep replaces each unknown by the value that satisfies its own equation with
+/// the neighbours' previous values (detail::jacobi_sweep), then refreshes the ghosts. One
+/// iteration = one sweep. With relative_residual the residual of the current iterate is
+/// evaluated before every sweep (a second stencil pass); with normalized_change the change
+/// of every sweep is reduced. Needs O(n^2) sweeps on an n-cell axis: it is the reference
+/// method; cg_poisson (poisson_cg.cuh) needs O(n).
+///
+/// Owns one scratch field (the previous iterate), allocated once. Usage:
+///
+///     sphere::jacobi_poisson<double, sphere::host> solver(grid);
+///     sphere::poisson_result r = solver.solve(eps, rhs, {sphere::z_boundary::neumann,
+///                                             sphere::z_boundary::dirichlet}, {});
+///     if (!r.converged) ...
+template <class Real, class Policy>
+class jacobi_poisson {
+public:
+    explicit jacobi_poisson(const fluid_grid<Real>& g) : problem_(g), scratch_(g.field_size(), Real(0)) {}
+
+    const fluid_grid<Real>& grid() const { return problem_.grid(); }
+
+    /// Solves A eps = rhs (file comment). eps and rhs point to fields of grid().field_size()
+    /// entries in the Policy's memory space; eps holds the initial guess and the Dirichlet
+    /// values on entry and the solution, with every ghost filled, on return. Throws on bad
+    /// settings, nz < 3 with a Dirichlet end, or a residual that becomes NaN or infinite.
+    poisson_result solve(Real* eps, const Real* rhs, const poisson_boundaries& bc, const poisson_settings& st)
+    {
+        problem_.prepare(bc, st);
+        problem_.fill_ghosts(eps);
+        problem_.remove_means(eps, rhs);
+        const detail::poisson_stencil<Real>& s = problem_.stencil();
+        const double D = 2 * (s.cx + s.cy + s.cz);
+        const detail::jacobi_sweep<Real> sweep_base{s,       Real(s.cx / D), Real(s.cy / D), Real(s.cz / D),
+                                                    Real(1 / D), Real(problem_.shift().hi + problem_.shift().lo), rhs, nullptr, nullptr};
+        const bool relative = st.criterion == poisson_criterion::relative_residual;
+        const double b_norm = relative ? problem_.rhs_norm(eps, rhs) : 0.0;
+
+        poisson_result result;
+        Real* current = eps;
+        Real* next = scratch_.data();
+        if (relative) {
+            problem_.copy(eps, next); // the Dirichlet layers of both buffers
+            for (;;) {
+                const double r = problem_.residual_norm(current, rhs);
+                result.residual = b_norm > 0 ? r / b_norm : r;
+                problem_.check_finite(result.residual, result.iterations);
+                if (result.residual <= st.tolerance) {
+                    result.converged = true;
+                    break;
+                }
+                if (result.iterations == st.max_iterations) break;
+                sweep(sweep_base, current, next);
+                Real* t = current;
+                current = next;
+                next = t;
+                ++result.iterations;
+            }
+        } else {
+            const double r = problem_.residual_norm(current, rhs);
+            problem_.check_finite(r, 0);
+            if (r == 0) {
+                result.converged = true;
+            } else {
+                problem_.copy(eps, next);
+                while (result.iterations < st.max_iterations) {
+                    sweep(sweep_base, current, next);
+                    result.residual = problem_.normalized_change(next, current, nullptr, 0.0);
+                    Real* t = current;
+                    current = next;
+                    next = t;
+                    ++result.iterations;
+                    problem_.check_finite(result.residual, result.iterations);
+                    if (result.residual <= st.tolerance) {
+                        result.converged = true;
+                        break;
+                    }
+                }
+            }
+        }
+        if (current != eps) problem_.copy(current, eps);
+        problem_.finish(eps);
+        return result;
+    }
+
+private:
+    void sweep(detail::jacobi_sweep<Real> k, const Real* from, Real* to)
+    {
+        k.old = from;
+        k.out = to;
+        problem_.for_each_unknown(k);
+        problem_.fill_ghosts(to);
+    }
+
+    detail::poisson_problem<Real, Policy> problem_;
+    buffer<Real, Policy> scratch_;
+};
+
+} // namespace sphere
