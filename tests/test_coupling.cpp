@@ -41,30 +41,16 @@ sphere::settings<Real> periodic_column(double lx, double ly, double lz, double k
     return s;
 }
 
-/// Terminal slip speed u of a sphere of diameter d under the net downward force F (N) with
-/// Law's per-particle drag coefficient at porosity phi: F = beta_per_solid(phi, d, u) V u.
-template <class Law>
-double terminal_slip(double F, double phi, double d, double rho_f, double mu_f)
-{
-    const double V = pi / 6 * d * d * d;
-    double lo = 0, hi = 1;
-    for (int it = 0; it < 200; ++it) {
-        const double u = 0.5 * (lo + hi);
-        (Law::beta_per_solid(phi, d, u, rho_f, mu_f) * V * u < F ? lo : hi) = u;
-    }
-    return 0.5 * (lo + hi);
-}
-
 } // namespace
 
-TEST_CASE("F6 reference values of the drag law", "[coupling][F6]")
+TEST_CASE("F6 reference values: terminal_speed of the Wen-Yu law", "[coupling][F6]")
 {
     // VALIDATION F6: d = 1 mm, rho_p = 2600, rho_f = 1000, mu = 0.1 Pa s.
     const double d = 1e-3, V = pi / 6 * d * d * d, g = 9.81;
     const double buoyant = (2600 - 1000) * g * V, heavy = 2600 * g * V;
-    CHECK(terminal_slip<sphere::drag::wen_yu>(buoyant, 1.0, d, 1000, 0.1) == Approx(8.48621e-3).epsilon(1e-5));
-    CHECK(terminal_slip<sphere::drag::wen_yu>(buoyant, 0.992, d, 1000, 0.1) == Approx(8.31185e-3).epsilon(1e-5));
-    CHECK(terminal_slip<sphere::drag::wen_yu>(heavy, 0.992, d, 1000, 0.1) == Approx(1.33709e-2).epsilon(1e-5));
+    CHECK(sphere::drag::terminal_speed<sphere::drag::wen_yu>(buoyant, 1.0, d, 1000, 0.1) == Approx(8.48621e-3).epsilon(1e-5));
+    CHECK(sphere::drag::terminal_speed<sphere::drag::wen_yu>(buoyant, 0.992, d, 1000, 0.1) == Approx(8.31185e-3).epsilon(1e-5));
+    CHECK(sphere::drag::terminal_speed<sphere::drag::wen_yu>(heavy, 0.992, d, 1000, 0.1) == Approx(1.33709e-2).epsilon(1e-5));
 }
 
 TEMPLATE_TEST_CASE("F6: one particle settles at the terminal slip velocity of its cell's porosity", "[coupling][F6]",
@@ -105,7 +91,7 @@ TEMPLATE_TEST_CASE("F6: one particle settles at the terminal slip velocity of it
         const double slip = v_f - snap.v[0].z;
         const double V = pi / 6 * d * d * d;
         const double force = (pressure_force ? rho_p - rho_f : rho_p) * g * V;
-        const double expected = terminal_slip<sphere::drag::gidaspow>(force, phi, d, rho_f, mu);
+        const double expected = sphere::drag::terminal_speed<sphere::drag::gidaspow>(force, phi, d, rho_f, mu);
         INFO("particle at z = " << x.z << " m in cell " << k << " with porosity " << phi << "; v_p = " << snap.v[0].z
                                 << ", v_f = " << v_f << " m/s");
         CHECK(phi > 0.99);

@@ -49,21 +49,12 @@ struct fluid_particle_force {
     vec3<Real>* out;
     bool pressure_force;
 
-    SPHERE_HD long long cell_of(const vec3<Real>& x) const
-    {
-        int c[3];
-        for (int a = 0; a < 3; ++a) {
-            const Real s = (x[a] - f.grid.box.lo[a]) / f.grid.width[a];
-            int k = s > Real(0) ? int(s) : 0;
-            c[a] = k >= int(f.grid.n[a]) ? int(f.grid.n[a]) - 1 : k;
-        }
-        return f.at(c[0], c[1], c[2]);
-    }
-
     SPHERE_HD Real operator()(std::size_t i) const
     {
         const vec4<Real> x = p.x[i];
-        const long long c = cell_of(x.xyz());
+        int cell[3];
+        f.grid.cell_of(x.xyz(), cell);
+        const long long c = f.at(cell[0], cell[1], cell[2]);
         const Real r = x.w;
         const Real V = Real(4) / Real(3) * pi<Real> * r * r * r;
         const bool has_solid = por.d_p[c] > Real(0);
@@ -102,7 +93,7 @@ struct fluid_reaction {
 
 /// The pore fluid coupled to a simulation's particles. `Drag` is a drag law of sphere::drag,
 /// `Poisson` the pressure solver.
-template <class Real, class Policy, class Drag = drag::gidaspow, class Poisson = jacobi_poisson<Real, Policy>>
+template <class Real, class Policy, class Drag = drag::gidaspow, class Poisson = cg_poisson<Real, Policy>>
 class fluid_coupling {
 public:
     fluid_coupling(const fluid_grid<Real>& g, const fluid_params<Real>& params, const coupling_options& options = {})

@@ -223,6 +223,24 @@ SPHERE_HD vec3<Real> fluid_force_density(Real beta, const vec3<Real>& relative_v
     return relative_velocity * (-beta);
 }
 
+/// Terminal slip speed u (m/s) of one sphere of diameter d (m) under the net force F (N) with
+/// Law's per-particle drag at porosity phi: the root of F = Law::beta_per_solid(phi, d, u) V u,
+/// V = pi d^3 / 6, by bisection (the drag grows monotonically with u). Host only. For a
+/// settling sphere F = (rho_p - rho_f) g V (with buoyancy) or rho_p g V (without).
+template <class Law>
+double terminal_speed(double F, double phi, double d, double rho_f, double mu_f)
+{
+    const double V = pi<double> / 6 * d * d * d;
+    const auto drag_at = [&](double u) { return Law::beta_per_solid(phi, d, u, rho_f, mu_f) * V * u; };
+    double lo = 0, hi = 1;
+    while (drag_at(hi) < F && hi < 1e12) hi *= 2;
+    for (int it = 0; it < 200; ++it) {
+        const double u = 0.5 * (lo + hi);
+        (drag_at(u) < F ? lo : hi) = u;
+    }
+    return 0.5 * (lo + hi);
+}
+
 /// Host-side checks of the drag inputs (kernels never throw). Each throws sphere::error naming
 /// the value: `where` prefixes the message (e.g. "fluid cell (1, 2, 3)").
 template <class Real>

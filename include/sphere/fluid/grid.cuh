@@ -60,6 +60,17 @@ struct fluid_grid {
                 box.lo.z + (Real(k) + Real(0.5)) * width.z};
     }
 
+    /// Coordinates c[0..2] of the cell holding the point x (m), clamped to the grid (a point
+    /// on or beyond a face belongs to the outermost cell).
+    SPHERE_HD void cell_of(const vec3<Real>& x, int c[3]) const
+    {
+        for (int a = 0; a < 3; ++a) {
+            const Real s = (x[a] - box.lo[a]) / width[a];
+            const int k = s > Real(0) ? static_cast<int>(s) : 0;
+            c[a] = k >= static_cast<int>(n[a]) ? static_cast<int>(n[a]) - 1 : k;
+        }
+    }
+
     /// The smallest of the three cell widths (m).
     SPHERE_HD Real min_width() const
     {
