@@ -37,19 +37,6 @@ struct options {
     double safety = 0.2;            // automatic fluid step: this fraction of the smallest limit
 };
 
-/// Coordinates of the fluid cell holding x (clamped to the grid), as the coupling finds it.
-template <class Real>
-std::size_t field_cell_of(const sphere::fluid_grid<Real>& g, const sphere::vec3<Real>& x)
-{
-    int c[3];
-    for (int a = 0; a < 3; ++a) {
-        const Real s = (x[a] - g.box.lo[a]) / g.width[a];
-        const int k = s > Real(0) ? int(s) : 0;
-        c[a] = k >= int(g.n[a]) ? int(g.n[a]) - 1 : k;
-    }
-    return g.field_index(c[0], c[1], c[2]);
-}
-
 /// What one output row holds.
 struct state {
     double time = 0;        ///< s
@@ -119,7 +106,9 @@ int run(const options& o)
             for (int j = 0; j < int(ny); ++j)
                 for (int i = 0; i < int(nx); ++i) phi_min = std::min(phi_min, double(por.phi[grid.field_index(i, j, k)]));
         for (std::size_t i = 0; i < snap.size(); ++i) {
-            const std::size_t c = field_cell_of(grid, snap.position(i));
+            int cell[3];
+            grid.cell_of(snap.position(i), cell);
+            const std::size_t c = grid.field_index(cell[0], cell[1], cell[2]);
             const double beta = double(Drag::beta_per_solid(por.phi[c], por.d_p[c], Real(0), prm.density, prm.viscosity));
             response = std::min(response, o.sample.density / beta);
         }
