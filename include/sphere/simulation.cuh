@@ -28,13 +28,6 @@
 namespace sphere {
 
 namespace detail {
-template <class Real>
-struct copy_positions {
-    const vec4<Real>* from;
-    vec4<Real>* to;
-    SPHERE_HD void operator()(std::size_t i) const { to[i] = from[i]; }
-};
-
 /// What the particles do to the boundaries in one step: their forces on the six walls along
 /// the axes (N) and the power of the agent that drives the prescribed particles (W), both
 /// summed in double.
@@ -286,7 +279,7 @@ public:
     /// External forces on the particles (N; policy memory, one per particle in user order), added
     /// to the contact force of every free particle at each step until overwritten; zero until
     /// written. The pore-fluid coupling writes them (docs/fluid.md, *Coupling*). Their work is
-    /// not part of energy().boundary_work.
+    /// not part of energy().boundary_work (the coupling books it: work_on_particles()).
     vec3<Real>* external_forces()
     {
         if (external_.size() != size()) external_ = buffer<vec3<Real>, Policy>(size(), vec3<Real>{0, 0, 0});

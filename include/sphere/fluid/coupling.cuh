@@ -14,15 +14,18 @@
 ///      so that momentum is exchanged exactly (summed per cell in particle order:
 ///      deterministic);
 ///   4. the fluid advances by dt_f (its own stability limits checked), then the DEM by
-///      dem_steps steps with the forces held constant.
+///      dem_steps steps with the forces held constant; the work the forces did on the free
+///      particles (force times displacement) is added to work_on_particles().
 /// The forces are explicit: dt_f must not exceed the shortest particle response time
 /// m_i / (beta_per_solid V_i) (checked; the step throws naming the particle).
 #include <cstddef>
 
+#include "../boundary/world.cuh"
 #include "../core/constants.cuh"
 #include "../core/error.cuh"
 #include "../core/vec.cuh"
 #include "../exec/algorithms.cuh"
+#include "../exec/buffer.cuh"
 #include "../exec/for_each.cuh"
 #include "../grid/neighbor_grid.cuh"
 #include "../particles/state.cuh"
@@ -89,6 +92,23 @@ struct fluid_reaction {
     }
 };
 
+/// The work (J) the fluid force did on free particle i over a coupled step: the force, held
+/// constant, times the particle's displacement (nearest periodic image) since the step began.
+template <class Real>
+struct fluid_work_on_particle {
+    world<Real> box;
+    const vec4<Real>* before;
+    particle_view<Real> p;
+    const vec3<Real>* force;
+
+    SPHERE_HD double operator()(std::size_t i) const
+    {
+        if (static_cast<motion>(p.kind[i]) != motion::free) return 0;
+        const vec3<Real> d = box.nearest_image(p.x[i].xyz() - before[i].xyz());
+        return double(force[i].x) * double(d.x) + double(force[i].y) * double(d.y) + double(force[i].z) * double(d.z);
+    }
+};
+
 } // namespace detail
 
 /// The pore fluid coupled to a simulation's particles. `Drag` is a drag law of sphere::drag,
@@ -130,13 +150,27 @@ public:
         for_each_index(Policy{}, fluid_.grid().cell_count(),
                        detail::fluid_reaction<Real>{fluid_.view(), porosity_.bins(), forces});
         fluid_.step(dt);
+        if (x_before_.size() != p.n) x_before_ = buffer<vec4<Real>, Policy>(p.n);
+        for_each_index(Policy{}, p.n, detail::copy_positions<Real>{p.x, x_before_.data()});
         sim.run(options_.dem_steps);
+        work_ += transform_reduce(
+            Policy{}, p.n,
+            detail::fluid_work_on_particle<Real>{sim.config().box, x_before_.data(), sim.particle_data(), forces}, 0.0,
+            plus_op{});
     }
+
+    /// Work done by the fluid on the free particles so far (J): the sum over coupled steps of
+    /// each particle's fluid force times its displacement in that step (exact for forces held
+    /// constant over the step). With it the particles' energy budget closes:
+    /// sim.energy().total() - its initial value = work_on_particles().
+    double work_on_particles() const { return work_; }
 
 private:
     coupling_options options_;
     porosity_estimator<Real, Policy> porosity_;
     navier_stokes<Real, Policy, Poisson> fluid_;
+    buffer<vec4<Real>, Policy> x_before_;  ///< positions at the start of the DEM steps
+    double work_ = 0;                      ///< work_on_particles() (J)
 };
 
 } // namespace sphere

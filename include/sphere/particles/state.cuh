@@ -35,6 +35,17 @@ struct particle_view {
     std::uint8_t* kind;     ///< motion, as its underlying value
 };
 
+namespace detail {
+/// Copies particle i's position and radius (kernel body): positions at a reference time, for
+/// displacements since then.
+template <class Real>
+struct copy_positions {
+    const vec4<Real>* from;
+    vec4<Real>* to;
+    SPHERE_HD void operator()(std::size_t i) const { to[i] = from[i]; }
+};
+} // namespace detail
+
 /// A host copy of every per-particle field, in the user's particle order.
 template <class Real>
 struct particle_snapshot {
