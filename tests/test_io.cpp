@@ -7,6 +7,8 @@
 //     field exactly (parsed here independently; tests/vtk_read.py reads them with VTK itself).
 #include <catch2/catch.hpp>
 
+#include "temp_folder.hpp"
+
 #include "support.hpp"
 
 #include <sphere/io.cuh>
@@ -41,28 +43,8 @@ namespace fs = std::filesystem;
 using sphere::vec3;
 using sphere::vec4;
 
-/// A fresh folder under the system's temporary folder, removed when the test leaves.
-struct temp_folder {
-    std::string path;
-    temp_folder()
-    {
-        std::string pattern = (fs::temp_directory_path() / "sphere_test_io_XXXXXX").string();
-        REQUIRE(::mkdtemp(&pattern[0]) != nullptr);
-        path = pattern;
-    }
-    ~temp_folder()
-    {
-        std::error_code ec;
-        fs::remove_all(path, ec);
-    }
-    std::string operator/(const std::string& name) const { return path + "/" + name; }
-};
-
-std::string read_bytes(const std::string& path)
-{
-    std::ifstream in(path, std::ios::binary);
-    return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-}
+using sphere_test::read_bytes;
+using sphere_test::temp_folder;
 
 void write_bytes(const std::string& path, const std::string& bytes)
 {

@@ -6,6 +6,8 @@
 // VTK's own reader (CTest fluid_io_vti_read).
 #include <catch2/catch.hpp>
 
+#include "temp_folder.hpp"
+
 #include <sphere/dem.cuh>
 #include <sphere/fluid.cuh>
 #include <sphere/io/vti.cuh>
@@ -28,30 +30,8 @@ namespace {
 namespace fs = std::filesystem;
 using sphere::vec3;
 
-/// A fresh folder under the system's temporary folder, removed when the test leaves.
-struct temp_folder {
-    std::string path;
-    temp_folder()
-    {
-        std::string pattern = (fs::temp_directory_path() / "sphere_test_vti_XXXXXX").string();
-        REQUIRE(::mkdtemp(&pattern[0]) != nullptr);
-        path = pattern;
-    }
-    ~temp_folder()
-    {
-        std::error_code ec;
-        fs::remove_all(path, ec);
-    }
-    std::string operator/(const std::string& name) const { return path + "/" + name; }
-};
-
-std::string read_text(const std::string& path)
-{
-    std::ifstream in(path, std::ios::binary);
-    std::ostringstream s;
-    s << in.rdbuf();
-    return s.str();
-}
+using sphere_test::read_bytes;
+using sphere_test::temp_folder;
 
 /// The value of attribute `name` of the first element `<tag ...>` in `text`.
 std::string attribute(const std::string& text, const std::string& tag, const std::string& name)
@@ -234,14 +214,14 @@ TEMPLATE_TEST_CASE("vti: write_vti and vti_writer write the text atomically, num
     temp_folder dir;
     const sphere::vti_fields<Real> f = known_fields<Real>(false);
     sphere::write_vti(dir / "one.vti", f, 0.5);
-    CHECK(read_text(dir / "one.vti") == sphere::vti_text(f, 0.5));
+    CHECK(read_bytes(dir / "one.vti") == sphere::vti_text(f, 0.5));
     CHECK_FALSE(fs::exists(dir / "one.vti.tmp"));
 
     sphere::vti_writer out(dir / "frames", "water");
     CHECK(out.write(f, 0.0) == dir / "frames/water_000000.vti");
     CHECK(out.write(f, 0.25) == dir / "frames/water_000001.vti");
     CHECK(out.frames() == 2);
-    CHECK(read_text(dir / "frames/water_000001.vti") == sphere::vti_text(f, 0.25));
+    CHECK(read_bytes(dir / "frames/water_000001.vti") == sphere::vti_text(f, 0.25));
     const sphere::pvd_collection pvd = sphere::pvd_collection::load(dir / "frames/water.pvd");
     REQUIRE(pvd.entries().size() == 2);
     CHECK(pvd.entries()[0].file == "water_000000.vti");
@@ -289,7 +269,7 @@ TEMPLATE_TEST_CASE("vti: a Navier-Stokes solver writes its pressure, cell-centre
     }
     temp_folder dir;
     sphere::write_vti(dir / "ns.vti", fluid, 1.5);
-    CHECK(read_text(dir / "ns.vti") == text);
+    CHECK(read_bytes(dir / "ns.vti") == text);
 }
 
 TEMPLATE_TEST_CASE("vti: a coupled fluid also writes the porosity rate", "[io][vti]", float, double)
@@ -330,6 +310,6 @@ TEMPLATE_TEST_CASE("vti: a coupled fluid also writes the porosity rate", "[io][v
     temp_folder dir;
     sphere::vti_writer out(dir.path);
     out.write(coupled, sim.time());
-    CHECK(read_text(dir / "fluid_000000.vti") == sphere::vti_text(sphere::fluid_fields(coupled), sim.time()));
+    CHECK(read_bytes(dir / "fluid_000000.vti") == sphere::vti_text(sphere::fluid_fields(coupled), sim.time()));
     CHECK(fs::exists(dir / "fluid.pvd"));
 }

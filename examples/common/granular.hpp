@@ -7,6 +7,8 @@
 
 #include <CLI/CLI.hpp>
 
+#include "run_options.hpp"
+
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -23,8 +25,9 @@ namespace granular {
 /// Options every granular example takes. The defaults are the validation set P of
 /// ../shared/VALIDATION.md (R = 1 cm, rho = 2500 kg/m^3, k_n = 1e5 N/m): stiff enough that a
 /// 10 kPa load compresses a contact by ~0.2% of a diameter, coarse enough that the examples
-/// finish in about a minute on 2 cores.
-struct sample_options {
+/// finish in about a minute on 2 cores. Also the output folder, precision and quiet flag
+/// (example::run_options).
+struct sample_options : example::run_options {
     std::size_t particles = 800;
     double radius = 0.01;         ///< mean radius (m)
     double spread = 0.1;          ///< radii uniform in radius (1 +- spread)
@@ -34,10 +37,7 @@ struct sample_options {
     double restitution = 0.5;     ///< normal restitution of two mean particles (sets gamma_n)
     std::uint64_t seed = 1;       ///< radii and initial positions
     double output_interval = 0.02; ///< simulated time between VTK frames and CSV rows (s)
-    std::string out;              ///< output folder
     double wall_mass = 0.1;       ///< mass of a stress-controlled wall, in units of the total particle mass
-    std::string precision = "double";
-    bool quiet = false;           ///< no progress line
 };
 
 inline void add_sample_options(CLI::App& app, sample_options& o)
@@ -59,10 +59,7 @@ inline void add_sample_options(CLI::App& app, sample_options& o)
         ->check(CLI::PositiveNumber)->capture_default_str();
     app.add_option("--wall-mass", o.wall_mass, "mass of a stress-controlled wall / total particle mass")
         ->check(CLI::PositiveNumber)->capture_default_str();
-    app.add_option("-o,--out", o.out, "output folder (created)")->capture_default_str();
-    app.add_option("--precision", o.precision, "float or double")->check(CLI::IsMember({"float", "double"}))
-        ->capture_default_str();
-    app.add_flag("-q,--quiet", o.quiet, "no progress line");
+    example::add_run_options(app, o);
 }
 
 template <class Real>
@@ -246,16 +243,6 @@ void run_phase(Sim& sim, const char* name, double duration, bool quiet,
 
 /// Calls run<float>(o) or run<double>(o) by the --precision option and turns a sphere::error
 /// (or any exception) into a message on stderr and exit status 1.
-template <class Run>
-int run_in_precision(const sample_options& o, Run run)
-{
-    try {
-        return o.precision == "float" ? run(float{}) : run(double{});
-    } catch (const std::exception& ex) {
-        if (!o.quiet) std::fprintf(stderr, "\n");
-        std::cerr << ex.what() << '\n';
-        return 1;
-    }
-}
+using example::run_in_precision;
 
 } // namespace granular

@@ -11,20 +11,20 @@
 
 #include <CLI/CLI.hpp>
 
+#include "../common/run_options.hpp"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstddef>
 #include <cstdio>
-#include <exception>
-#include <iostream>
 #include <limits>
 #include <string>
 #include <vector>
 
 namespace {
 
-struct options {
+struct options : example::run_options {
     double dp = 8;                   // bottom minus top pressure (Pa)
     double diameter = 1e-3;          // particle diameter = lattice spacing (m); fluid cells are 2 d wide
     double fluid_density = 1000;     // kg/m^3
@@ -36,9 +36,6 @@ struct options {
     double duration = 0.2;           // longest simulated time (s)
     double steady = 1e-7;            // relative change of U per step that counts as steady
     double output_interval = 0.01;   // s
-    std::string out = "permeability-output";
-    std::string precision = "double";
-    bool quiet = false;
 };
 
 /// The measured state of the bed's interior: cells 2 .. nz - 4 (away from the prescribed
@@ -206,6 +203,7 @@ int run(const options& o)
 int main(int argc, char** argv)
 {
     options o;
+    o.out = "permeability-output";
     CLI::App app{"permeability: a pressure difference drives fluid through a fixed simple-cubic bed until the flow "
                  "is steady; prints the flux, the pressure profile, the permeability and Ergun's predictions"};
     app.add_option("--dp", o.dp, "pressure of the bottom layer minus that of the top layer (Pa)")
@@ -229,16 +227,7 @@ int main(int argc, char** argv)
         ->check(CLI::PositiveNumber)->capture_default_str();
     app.add_option("--output-interval", o.output_interval, "simulated time between outputs (s)")
         ->check(CLI::PositiveNumber)->capture_default_str();
-    app.add_option("-o,--out", o.out, "output folder (created)")->capture_default_str();
-    app.add_option("--precision", o.precision, "float or double")->check(CLI::IsMember({"float", "double"}))
-        ->capture_default_str();
-    app.add_flag("-q,--quiet", o.quiet, "no progress line");
+    example::add_run_options(app, o);
     CLI11_PARSE(app, argc, argv);
-    try {
-        return o.precision == "float" ? run<float>(o) : run<double>(o);
-    } catch (const std::exception& ex) {
-        if (!o.quiet) std::fprintf(stderr, "\n");
-        std::cerr << ex.what() << '\n';
-        return 1;
-    }
+    return example::run_in_precision(o, [&](auto real) { return run<decltype(real)>(o); });
 }

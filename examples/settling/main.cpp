@@ -11,13 +11,13 @@
 
 #include <CLI/CLI.hpp>
 
+#include "../common/run_options.hpp"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstddef>
 #include <cstdio>
-#include <exception>
-#include <iostream>
 #include <string>
 #include <vector>
 
@@ -25,7 +25,7 @@ namespace {
 
 constexpr double pi = 3.14159265358979323846;
 
-struct options {
+struct options : example::run_options {
     double diameter = 1e-3;         // m
     double particle_density = 2600; // kg/m^3
     double fluid_density = 1000;    // kg/m^3
@@ -39,9 +39,6 @@ struct options {
     double duration = 0.04;         // s
     double output_interval = 0.002; // s
     bool no_pressure_force = false;
-    std::string out = "settling-output";
-    std::string precision = "double";
-    bool quiet = false;
 };
 
 template <class Real>
@@ -176,6 +173,7 @@ int run(const options& o)
 int main(int argc, char** argv)
 {
     options o;
+    o.out = "settling-output";
     CLI::App app{"settling: one sphere sinking through a viscous fluid column (two-way coupled); prints its "
                  "velocity, the fluid's and the slip against time, and the terminal slip velocity against Stokes "
                  "and Schiller-Naumann/Wen-Yu"};
@@ -203,16 +201,7 @@ int main(int argc, char** argv)
         ->check(CLI::PositiveNumber)->capture_default_str();
     app.add_flag("--no-pressure-force", o.no_pressure_force,
                  "leave out the pressure-gradient (buoyancy) force on the particle");
-    app.add_option("-o,--out", o.out, "output folder (created)")->capture_default_str();
-    app.add_option("--precision", o.precision, "float or double")->check(CLI::IsMember({"float", "double"}))
-        ->capture_default_str();
-    app.add_flag("-q,--quiet", o.quiet, "no progress line");
+    example::add_run_options(app, o);
     CLI11_PARSE(app, argc, argv);
-    try {
-        return o.precision == "float" ? run<float>(o) : run<double>(o);
-    } catch (const std::exception& ex) {
-        if (!o.quiet) std::fprintf(stderr, "\n");
-        std::cerr << ex.what() << '\n';
-        return 1;
-    }
+    return example::run_in_precision(o, [&](auto real) { return run<decltype(real)>(o); });
 }

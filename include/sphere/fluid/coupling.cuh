@@ -83,12 +83,12 @@ struct fluid_reaction {
 
     SPHERE_HD void operator()(std::size_t cell) const
     {
-        int i, j, k;
-        f.grid.coordinates(cell, i, j, k);
+        int k;
+        const long long c = f.cell_field(cell, k);
         vec3<Real> sum{0, 0, 0};
         for (unsigned s = bins.cell_start[cell]; s < bins.cell_start[cell + 1]; ++s) sum += particle_force[bins.order[s]];
         const Real volume = f.grid.width.x * f.grid.width.y * f.grid.width.z;
-        f.force[f.at(i, j, k)] = sum * (Real(-1) / volume);
+        f.force[c] = sum * (Real(-1) / volume);
     }
 };
 

@@ -53,6 +53,22 @@ struct fluid_grid {
         return (std::size_t(k + 1) * (n[1] + 2) + std::size_t(j + 1)) * (n[0] + 2) + std::size_t(i + 1);
     }
 
+    /// Coordinates (each in [-1, n]) of field index f (the inverse of `field_index`).
+    SPHERE_HD void field_coordinates(std::size_t f, int& i, int& j, int& k) const
+    {
+        i = static_cast<int>(f % (n[0] + 2)) - 1;
+        f /= (n[0] + 2);
+        j = static_cast<int>(f % (n[1] + 2)) - 1;
+        k = static_cast<int>(f / (n[1] + 2)) - 1;
+    }
+
+    /// Whether (i, j, k) is a cell (not a ghost node).
+    SPHERE_HD bool is_cell(int i, int j, int k) const
+    {
+        return i >= 0 && j >= 0 && k >= 0 && i < static_cast<int>(n[0]) && j < static_cast<int>(n[1]) &&
+               k < static_cast<int>(n[2]);
+    }
+
     /// Centre (m) of cell (i, j, k); also of ghost nodes (-1 or n).
     SPHERE_HD vec3<Real> centre(int i, int j, int k) const
     {

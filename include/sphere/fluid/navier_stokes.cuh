@@ -39,9 +39,14 @@ struct fluid_view {
     Real rho, mu;
     bool wall_bottom, wall_top;  ///< no-flow ends (else prescribed pressure)
 
-    SPHERE_HD long long at(int i, int j, int k) const
+    /// fluid_grid::field_index, signed so that neighbours can be reached by subtraction.
+    SPHERE_HD long long at(int i, int j, int k) const { return static_cast<long long>(grid.field_index(i, j, k)); }
+    /// The field index of cell number `cell` (fluid_grid::index numbering), and its layer k.
+    SPHERE_HD long long cell_field(std::size_t cell, int& k) const
     {
-        return ((long long)(k + 1) * (grid.n[1] + 2) + (j + 1)) * (grid.n[0] + 2) + (i + 1);
+        int i, j;
+        grid.coordinates(cell, i, j, k);
+        return at(i, j, k);
     }
     /// Whether the face of axis a at field index of cell (i, j, k) carries an unknown velocity:
     /// every x and y face; the z faces between two cells.
@@ -68,54 +73,39 @@ struct fluid_view {
 
 namespace detail {
 
-/// Source node of ghost node (i, j, k): periodic in x and y, nearest cell in z.
-SPHERE_HD inline void ghost_source(const unsigned n[3], int& i, int& j, int& k)
+/// Source cell of ghost node (i, j, k): periodic in x and y, nearest cell in z.
+template <class Real>
+SPHERE_HD void ghost_source(const fluid_grid<Real>& g, int& i, int& j, int& k)
 {
-    const int nx = int(n[0]), ny = int(n[1]), nz = int(n[2]);
+    const int nx = int(g.n[0]), ny = int(g.n[1]), nz = int(g.n[2]);
     i = i < 0 ? i + nx : (i >= nx ? i - nx : i);
     j = j < 0 ? j + ny : (j >= ny ? j - ny : j);
     k = k < 0 ? 0 : (k >= nz ? nz - 1 : k);
 }
 
-SPHERE_HD inline void field_coordinates(const unsigned n[3], std::size_t f, int& i, int& j, int& k)
-{
-    i = int(f % (n[0] + 2)) - 1;
-    f /= (n[0] + 2);
-    j = int(f % (n[1] + 2)) - 1;
-    k = int(f / (n[1] + 2)) - 1;
-}
-
-SPHERE_HD inline bool is_ghost(const unsigned n[3], int i, int j, int k)
-{
-    return i < 0 || j < 0 || k < 0 || i >= int(n[0]) || j >= int(n[1]) || k >= int(n[2]);
-}
-
-/// Fills the ghost nodes of a cell-centred field: periodic copies in x and y; along z a copy
-/// of the nearest cell, or (extrapolate_z) the linear extrapolation 2 f(0) - f(1).
-template <class T>
+/// Fills the ghost nodes of a cell-centred field of T (Real or vec3<Real>): periodic copies in
+/// x and y; along z a copy of the nearest cell, or (extrapolate_z) the linear extrapolation
+/// 2 f(0) - f(1).
+template <class Real, class T>
 struct fill_cell_ghosts {
-    unsigned n[3];
+    fluid_grid<Real> g;
     T* f;
     bool extrapolate_z;
 
     SPHERE_HD void operator()(std::size_t node) const
     {
         int i, j, k;
-        field_coordinates(n, node, i, j, k);
-        if (!is_ghost(n, i, j, k)) return;
+        g.field_coordinates(node, i, j, k);
+        if (g.is_cell(i, j, k)) return;
         const int kz = k;
-        ghost_source(n, i, j, k);
-        const std::size_t s = index(i, j, k);
-        if (extrapolate_z && kz != k && n[2] > 1) {
-            const int inner = kz < 0 ? 1 : int(n[2]) - 2;
-            f[node] = f[s] + (f[s] - f[index(i, j, inner)]);
+        ghost_source(g, i, j, k);
+        const std::size_t s = g.field_index(i, j, k);
+        if (extrapolate_z && kz != k && g.n[2] > 1) {
+            const int inner = kz < 0 ? 1 : int(g.n[2]) - 2;
+            f[node] = f[s] + (f[s] - f[g.field_index(i, j, inner)]);
         } else {
             f[node] = f[s];
         }
-    }
-    SPHERE_HD std::size_t index(int i, int j, int k) const
-    {
-        return (std::size_t(k + 1) * (n[1] + 2) + std::size_t(j + 1)) * (n[0] + 2) + std::size_t(i + 1);
     }
 };
 
@@ -125,35 +115,32 @@ struct fill_cell_ghosts {
 /// shear stress at the ends: free slip).
 template <class Real>
 struct fill_velocity_ghosts {
-    unsigned n[3];
+    fluid_grid<Real> g;
     Real* u[3];
     bool wall_bottom, wall_top;
 
-    SPHERE_HD std::size_t index(int i, int j, int k) const
-    {
-        return (std::size_t(k + 1) * (n[1] + 2) + std::size_t(j + 1)) * (n[0] + 2) + std::size_t(i + 1);
-    }
     SPHERE_HD void operator()(std::size_t node) const
     {
         int i, j, k;
-        field_coordinates(n, node, i, j, k);
-        const int nz = int(n[2]);
+        g.field_coordinates(node, i, j, k);
+        const int nz = int(g.n[2]);
+        const bool ghost = !g.is_cell(i, j, k);
         // z faces: k = -1 and nz - 1 are the ends of the grid, nz lies beyond.
         if (k == -1 || k >= nz - 1) {
             int si = i, sj = j, sk = k;
-            ghost_source(n, si, sj, sk);
+            ghost_source(g, si, sj, sk);
             const bool bottom = k == -1;
             const bool wall = bottom ? wall_bottom : wall_top;
             const int inner = bottom ? 0 : nz - 2;
-            u[2][node] = (wall || nz < 2) ? Real(0) : u[2][index(si, sj, inner)];
-        } else if (is_ghost(n, i, j, k)) {
+            u[2][node] = (wall || nz < 2) ? Real(0) : u[2][g.field_index(si, sj, inner)];
+        } else if (ghost) {
             int si = i, sj = j, sk = k;
-            ghost_source(n, si, sj, sk);
-            u[2][node] = u[2][index(si, sj, sk)];
+            ghost_source(g, si, sj, sk);
+            u[2][node] = u[2][g.field_index(si, sj, sk)];
         }
-        if (is_ghost(n, i, j, k)) {
-            ghost_source(n, i, j, k);
-            const std::size_t s = index(i, j, k);
+        if (ghost) {
+            ghost_source(g, i, j, k);
+            const std::size_t s = g.field_index(i, j, k);
             u[0][node] = u[0][s];
             u[1][node] = u[1][s];
         }
@@ -176,9 +163,8 @@ struct predict_velocity {
 
     SPHERE_HD void operator()(std::size_t cell) const
     {
-        int i, j, k;
-        f.grid.coordinates(cell, i, j, k);
-        const long long c = f.at(i, j, k);
+        int k;
+        const long long c = f.cell_field(cell, k);
         for (int a = 0; a < 3; ++a) {
             if (!f.active_face(a, k)) continue;
             out[a][c] = f.u[a][c] + dt * acceleration(c, a);
@@ -237,9 +223,8 @@ struct poisson_rhs {
 
     SPHERE_HD void operator()(std::size_t cell) const
     {
-        int i, j, k;
-        f.grid.coordinates(cell, i, j, k);
-        const long long c = f.at(i, j, k);
+        int k;
+        const long long c = f.cell_field(cell, k);
         Real div = 0;
         for (int a = 0; a < 3; ++a) {
             const long long lo = c - f.stride[a];
@@ -277,9 +262,8 @@ struct correct_velocity {
 
     SPHERE_HD void operator()(std::size_t cell) const
     {
-        int i, j, k;
-        f.grid.coordinates(cell, i, j, k);
-        const long long c = f.at(i, j, k);
+        int k;
+        const long long c = f.cell_field(cell, k);
         for (int a = 0; a < 3; ++a) {
             if (!f.active_face(a, k)) continue;
             const Real grad = (eps[c + f.stride[a]] - eps[c]) / f.grid.width[a];
@@ -297,9 +281,8 @@ struct copy_porosity {
 
     SPHERE_HD void operator()(std::size_t cell) const
     {
-        int i, j, k;
-        f.grid.coordinates(cell, i, j, k);
-        const std::size_t c = f.grid.field_index(i, j, k);
+        int k;
+        const long long c = f.cell_field(cell, k);
         f.phi[c] = in.phi[c];
         f.dphi_dt[c] = in.dphi_dt[c];
     }
@@ -311,9 +294,8 @@ struct advective_rate {
     fluid_view<Real> f;
     SPHERE_HD Real operator()(std::size_t cell) const
     {
-        int i, j, k;
-        f.grid.coordinates(cell, i, j, k);
-        const long long c = f.at(i, j, k);
+        int k;
+        const long long c = f.cell_field(cell, k);
         Real r = 0;
         for (int a = 0; a < 3; ++a) {
             const Real hi = f.u[a][c], lo = f.u[a][c - f.stride[a]];
@@ -330,9 +312,8 @@ struct cell_porosity {
     fluid_view<Real> f;
     SPHERE_HD Real operator()(std::size_t cell) const
     {
-        int i, j, k;
-        f.grid.coordinates(cell, i, j, k);
-        return f.phi[f.at(i, j, k)];
+        int k;
+        return f.phi[f.cell_field(cell, k)];
     }
 };
 
@@ -343,10 +324,9 @@ struct face_momentum {
     int a;
     SPHERE_HD double operator()(std::size_t cell) const
     {
-        int i, j, k;
-        f.grid.coordinates(cell, i, j, k);
+        int k;
+        const long long c = f.cell_field(cell, k);
         if (!f.active_face(a, k)) return 0;
-        const long long c = f.at(i, j, k);
         return double(f.phi_face(c, a)) * double(f.u[a][c]);
     }
 };
@@ -503,7 +483,7 @@ public:
             detail::fail("fluid: time step dt = ", dt, " s exceeds the stability limit ", limit,
                          " s (diffusive phi rho h^2/(6 mu) or advective h/|v|); reduce dt or coarsen the grid");
         for_each_index(Policy{}, grid_.field_size(),
-                       detail::fill_cell_ghosts<vec3<Real>>{{grid_.n[0], grid_.n[1], grid_.n[2]}, force_.data(), false});
+                       detail::fill_cell_ghosts<Real, vec3<Real>>{grid_, force_.data(), false});
         const fluid_view<Real> f = view();
         Real* out[3] = {us_[0].data(), us_[1].data(), us_[2].data()};
         for_each_index(Policy{}, grid_.cell_count(),
@@ -531,17 +511,14 @@ private:
     void fill_cell_ghosts(buffer<Real, Policy>& b, bool extrapolate_z)
     {
         for_each_index(Policy{}, grid_.field_size(),
-                       detail::fill_cell_ghosts<Real>{{grid_.n[0], grid_.n[1], grid_.n[2]}, b.data(), extrapolate_z});
+                       detail::fill_cell_ghosts<Real, Real>{grid_, b.data(), extrapolate_z});
     }
     void fill_pressure_ghosts() { fill_cell_ghosts(p_, true); }
     void fill_velocity_ghosts(Real* const* u)
     {
         const fluid_view<Real> f = view();
         for_each_index(Policy{}, grid_.field_size(),
-                       detail::fill_velocity_ghosts<Real>{{grid_.n[0], grid_.n[1], grid_.n[2]},
-                                                         {u[0], u[1], u[2]},
-                                                         f.wall_bottom,
-                                                         f.wall_top});
+                       detail::fill_velocity_ghosts<Real>{grid_, {u[0], u[1], u[2]}, f.wall_bottom, f.wall_top});
     }
     void fill_velocity_ghosts()
     {
