@@ -59,10 +59,12 @@ void grid_rebuild(benchmark::State& state)
     const sphere::particle_view<Real> view = particles.view();
     sphere::neighbor_grid<Real, sphere::host> grid(
         sphere::grid_geometry<Real>::make(setup.settings.box, Real(2e-3), Real(0)));
-    sphere::contact_lists<Real, sphere::host> lists(n, 32);
+    sphere::contact_lists<Real, sphere::host> lists(n, true);
+    const sphere::wall_set<Real> walls = sphere::wall_set<Real>::from_world(setup.settings.box);
     for (auto _ : state) {
         grid.build(view);
-        benchmark::DoNotOptimize(lists.rebuild(grid.view(), Real(0)));
+        lists.rebuild(grid.view(), walls, Real(0), view.user);
+        benchmark::DoNotOptimize(lists.entries());
     }
     state.counters["particle_steps_per_s"] =
         benchmark::Counter(static_cast<double>(n), benchmark::Counter::kIsIterationInvariantRate);

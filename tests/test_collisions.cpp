@@ -176,7 +176,7 @@ struct damped_result {
     double elastic1; ///< elastic energy left after the collision (J)
 };
 
-template <class Real>
+template <class Real, class Integrator = sphere::integrate::semi_implicit_euler>
 damped_result damped_collision(bool wall, bool tension, Real dt, Real gap)
 {
     const Real r = set_p<Real>::radius;
@@ -192,7 +192,7 @@ damped_result damped_collision(bool wall, bool tension, Real dt, Real gap)
     } else {
         particles = {ball<Real>({-(r + gap / 2), 0, 0}, {1, 0, 0}), ball<Real>({r + gap / 2, 0, 0})};
     }
-    host_sim<Real> sim(s, particles);
+    host_sim<Real, Integrator> sim(s, particles);
     REQUIRE(sim.dt() == dt);
     damped_result out;
     out.ke0 = sim.energy().kinetic;
@@ -408,8 +408,13 @@ TEMPLATE_TEST_CASE("D1: integrators at the default time step (pitfall 1)", "[col
         const head_on_result semi = head_on<Real, integrate::semi_implicit_euler>(Real(0.01), Real(0.01), gap);
         const head_on_result taylor = head_on<Real, integrate::taylor2>(Real(0.01), Real(0.01), gap);
         const head_on_result euler = head_on<Real, integrate::explicit_euler>(Real(0.01), Real(0.01), gap);
+        const head_on_result verlet = head_on<Real, integrate::velocity_verlet>(Real(0.01), Real(0.01), gap);
         INFO("phase " << j << ": e = " << semi.v_b - semi.v_a << " (semi-implicit Euler), " << taylor.v_b - taylor.v_a
-                      << " (taylor2), " << euler.v_b - euler.v_a << " (explicit Euler)");
+                      << " (taylor2), " << euler.v_b - euler.v_a << " (explicit Euler), " << verlet.v_b - verlet.v_a
+                      << " (velocity Verlet)");
+        REQUIRE(verlet.c.separated);
+        CHECK(rel_err(verlet.v_b - verlet.v_a, 1.0) < 3e-3); // velocity Verlet: 1 within 0.3%, as the default
+        CHECK(norm_d(verlet.p1 - verlet.p0) / norm_d(verlet.p0) < (std::is_same<Real, float>::value ? 1e-6 : 1e-12));
         REQUIRE(semi.c.separated);
         REQUIRE(taylor.c.separated);
         REQUIRE(euler.c.separated);
@@ -439,9 +444,10 @@ const d2_reference d2_cases[] = {
 };
 } // namespace
 
-TEMPLATE_TEST_CASE("D2: damped restitution and contact duration", "[collision][D2]", float, double)
+namespace {
+template <class Real, class Integrator>
+void check_d2()
 {
-    using Real = TestType;
     // Tolerances (VALIDATION D2): 3% at the default dt, 0.5% at dt/10 (dt set explicitly).
     //
     // At the default dt, e depends on the entry phase: the dashpot switches on with a force
@@ -460,7 +466,7 @@ TEMPLATE_TEST_CASE("D2: damped restitution and contact duration", "[collision][D
             double e_mean = 0;
             for (int j = 0; j < n_phases; ++j) {
                 const damped_result r =
-                    damped_collision<Real>(ref.wall, ref.tension, Real(dt), Real(entry_gap(j, 1, dt)));
+                    damped_collision<Real, Integrator>(ref.wall, ref.tension, Real(dt), Real(entry_gap(j, 1, dt)));
                 INFO(ref.name << ", dt = " << dt << " s, phase " << j << ": e = " << r.e << " (" << ref.e
                               << "), t_c = " << r.c.t_c << " s (" << ref.t_c << "), force steps = "
                               << r.c.force_steps);
@@ -478,9 +484,9 @@ TEMPLATE_TEST_CASE("D2: damped restitution and contact duration", "[collision][D
     }
 }
 
-TEMPLATE_TEST_CASE("D3: energy audit of the damped collisions", "[collision][D3]", float, double)
+template <class Real, class Integrator>
+void check_d3()
 {
-    using Real = TestType;
     // KE0 = KE1 + E_visc, relative to KE0: no elastic energy is left once the bodies are apart,
     // and a head-on impact has no friction. Tolerances (VALIDATION D3): 2.5% at dt, 0.3% at
     // dt/10, at every entry phase.
@@ -489,7 +495,7 @@ TEMPLATE_TEST_CASE("D3: energy audit of the damped collisions", "[collision][D3]
             const double dt = dt_p / refine, tol = refine == 1 ? 2.5e-2 : 3e-3;
             for (int j = 0; j < n_phases; ++j) {
                 const damped_result r =
-                    damped_collision<Real>(ref.wall, ref.tension, Real(dt), Real(entry_gap(j, 1, dt)));
+                    damped_collision<Real, Integrator>(ref.wall, ref.tension, Real(dt), Real(entry_gap(j, 1, dt)));
                 INFO(ref.name << ", dt = " << dt << " s, phase " << j << ": KE0 = " << r.ke0 << ", KE1 = " << r.ke1
                               << ", E_visc = " << r.e_visc << " J, (KE1 + E_visc) / KE0 = "
                               << (r.ke1 + r.e_visc) / r.ke0);
@@ -506,6 +512,19 @@ TEMPLATE_TEST_CASE("D3: energy audit of the damped collisions", "[collision][D3]
             }
         }
     }
+}
+} // namespace
+
+TEMPLATE_TEST_CASE("D2: damped restitution and contact duration", "[collision][D2]", float, double)
+{
+    SECTION("semi-implicit Euler (default)") { check_d2<TestType, sphere::integrate::semi_implicit_euler>(); }
+    SECTION("velocity Verlet") { check_d2<TestType, sphere::integrate::velocity_verlet>(); }
+}
+
+TEMPLATE_TEST_CASE("D3: energy audit of the damped collisions", "[collision][D3]", float, double)
+{
+    SECTION("semi-implicit Euler (default)") { check_d3<TestType, sphere::integrate::semi_implicit_euler>(); }
+    SECTION("velocity Verlet") { check_d3<TestType, sphere::integrate::velocity_verlet>(); }
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -664,4 +683,48 @@ TEMPLATE_TEST_CASE("D6: oblique impact on a wall, sliding", "[collision][D6]", f
         CHECK(en.dissipated_visc == 0);
         CHECK(std::abs(slip - 0.029) < 0.029 * 1e-3);
     }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Mass-scaled damping (damping_convention::mass_scaled): c = gamma m* per contact.
+// ---------------------------------------------------------------------------------------------
+TEMPLATE_TEST_CASE("mass-scaled damping: each pair gets c = gamma m*, so its restitution follows its masses",
+                   "[collision][damping]", float, double)
+{
+    using Real = TestType;
+    // Head-on pairs of radii (r_a, r_b) at 1 m/s with tension allowed, at dt/10: with
+    // gamma = 1883.0 1/s every pair gets c_n = gamma m*, damping ratio zeta = gamma sqrt(m*) /
+    // (2 sqrt(k_n)), restitution exp(-pi zeta / sqrt(1 - zeta^2)): 0.5 for the set-P pair (m* = m/2),
+    // lower for heavier pairs. Tolerance 0.5% (VALIDATION D2 at dt/10).
+    const double gamma = 2 * gamma_pair / mass_p; // 1/s: c_n = gamma_pair for the set-P pair
+    struct pair_case {
+        double r_a, r_b;
+    };
+    for (const pair_case pc : {pair_case{0.01, 0.01}, pair_case{0.02, 0.01}, pair_case{0.015, 0.015}}) {
+        const double m_a = sphere::sphere_mass(pc.r_a, 2500.0), m_b = sphere::sphere_mass(pc.r_b, 2500.0);
+        const double m_eff = m_a * m_b / (m_a + m_b);
+        const double zeta = gamma * m_eff / (2 * std::sqrt(m_eff * k_n_p));
+        const double e_ref = sphere::restitution_from_damping_ratio(zeta, true);
+        sphere::settings<Real> s = box_settings<Real>();
+        s.contact.gamma_n = Real(gamma);
+        s.contact.damping = sphere::damping_convention::mass_scaled;
+        s.contact.tension = true;
+        s.dt = Real(dt_p / 10);
+        const Real gap = Real(1e-4);
+        host_sim<Real> sim(s, {ball<Real>({-(Real(pc.r_a) + gap / 2), 0, 0}, {1, 0, 0}, Real(pc.r_a)),
+                               ball<Real>({Real(pc.r_b) + gap / 2, 0, 0}, {0, 0, 0}, Real(pc.r_b))});
+        const contact_record c =
+            watch_collision(sim, [](const auto& snap) { return pair_state(snap); }, k_n_p, gamma * m_eff, true, 200000);
+        REQUIRE(c.separated);
+        const auto snap = sim.snapshot();
+        const double e = double(snap.v[1].x) - double(snap.v[0].x);
+        INFO("radii " << pc.r_a << ", " << pc.r_b << " m: m* = " << m_eff << " kg, e = " << e << " (" << e_ref << ")");
+        CHECK(rel_err(e, e_ref) < 5e-3);
+    }
+    // The validation names the units of the convention.
+    sphere::settings<Real> s = box_settings<Real>();
+    s.contact.damping = sphere::damping_convention::mass_scaled;
+    s.contact.gamma_n = Real(-1);
+    REQUIRE_THROWS_WITH((host_sim<Real>(s, {ball<Real>({0, 0, 0})})),
+                        Catch::Contains("settings.contact.gamma_n = -1 1/s (mass-scaled): must be non-negative"));
 }

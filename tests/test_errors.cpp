@@ -279,11 +279,6 @@ TEMPLATE_TEST_CASE("simulation settings are validated", "[errors][settings]", fl
         s.skin = nan_value<Real>();
         REQUIRE_SPHERE_ERROR(build(s, ps), Contains("settings.skin = ") && Contains("nan m: must be non-negative"));
     }
-    SECTION("zero contact capacity")
-    {
-        s.contact_capacity = 0;
-        REQUIRE_SPHERE_ERROR(build(s, ps), Contains("settings.contact_capacity = 0: must be at least 1"));
-    }
     SECTION("empty particle list")
     {
         REQUIRE_SPHERE_ERROR(build(s, std::vector<sphere::particle<Real>>{}),
@@ -427,14 +422,15 @@ TEMPLATE_TEST_CASE("the time step must be positive, finite and within the stable
     }
 }
 
-TEMPLATE_TEST_CASE("contact list overflow names the particle and the step", "[errors][contacts]", float, double)
+TEMPLATE_TEST_CASE("contact lists hold every partner they find, at setup and during the run", "[contacts]", float,
+                   double)
 {
     using Real = TestType;
     auto s = sphere_test::box_settings<Real>();
-    s.contact_capacity = 2;
     const Real r = sphere_test::set_p<Real>::radius;
-    // Particle 2 (fixed, at the origin) touches particles 0 (-x) and 1 (-y): 2 partners, at
-    // capacity. Particle 3 approaches from +x at 0.5 m/s (prescribed: moves exactly x += v dt).
+    // Particle 2 (fixed, at the origin) touches particles 0 (-x) and 1 (-y). Particle 3
+    // approaches from +x at 0.5 m/s (prescribed: moves exactly x += v dt) and becomes its third
+    // partner; no capacity limits the list.
     auto centre = sphere_test::ball<Real>({0, 0, 0});
     centre.kind = sphere::motion::fixed;
     std::vector<sphere::particle<Real>> ps = {sphere_test::ball<Real>({Real(-0.0199), 0, 0}),
@@ -443,34 +439,27 @@ TEMPLATE_TEST_CASE("contact list overflow names the particle and the step", "[er
     for (auto& p : ps)
         if (p.kind == sphere::motion::free) p.kind = sphere::motion::prescribed;
     ps[3].velocity = {Real(-0.5), 0, 0};
+    const std::vector<unsigned> two = {0, 1}, three = {0, 1, 3};
 
     SECTION("at setup")
     {
+        REQUIRE(sphere::simulation<Real>(s, ps).contacts().partners_of(2) == two);
         ps[3].position.x = Real(0.0199); // already touching: 3 partners
-        REQUIRE_SPHERE_ERROR(build(s, ps), Contains("step 0: particle 2 has 3 neighbours within r_i + r_j + skin, more "
-                                                    "than settings.contact_capacity = 2; raise the capacity"));
-        s.contact_capacity = 3;
-        REQUIRE_NOTHROW(build(s, ps));
+        REQUIRE(sphere::simulation<Real>(s, ps).contacts().partners_of(2) == three);
     }
     SECTION("during the run")
     {
         // Particle 3 enters reach when its centre is closer than 2 r = 0.02 m, i.e. after
-        // n > (0.0301 - 0.02) / (0.5 dt) steps; the lists are rebuilt at the start of the
-        // next step, which reports the number of steps done, n.
-        const double dt = double(sphere::simulation<Real>(s, ps).dt());
-        const double steps_to_reach = (0.0301 - 2 * double(r)) / (0.5 * dt);
+        // n > (0.0301 - 0.02) / (0.5 dt) steps; the lists are rebuilt at the start of the next step.
+        sphere::simulation<Real> sim(s, ps);
+        const double steps_to_reach = (0.0301 - 2 * double(r)) / (0.5 * double(sim.dt()));
         REQUIRE(steps_to_reach - std::floor(steps_to_reach) > 0.2); // well away from a step boundary
-        REQUIRE(steps_to_reach - std::floor(steps_to_reach) < 0.8);
         const std::size_t n = static_cast<std::size_t>(std::floor(steps_to_reach)) + 1;
-        auto run = [&] {
-            sphere::simulation<Real> sim(s, ps);
-            sim.run(n + 10);
-        };
-        REQUIRE_SPHERE_ERROR(run(), Contains("step " + std::to_string(n) + ": particle 2 has 3 neighbours within "
-                                                                            "r_i + r_j + skin, more than "
-                                                                            "settings.contact_capacity = 2"));
-        sphere::simulation<Real> sim(s, ps); // one step earlier it still runs
-        REQUIRE_NOTHROW(sim.run(n));
+        sim.run(n);
+        REQUIRE(sim.contacts().partners_of(2) == two);
+        sim.run(1);
+        REQUIRE(sim.contacts().partners_of(2) == three);
+        REQUIRE(sim.contacts().partners_of(3) == std::vector<unsigned>{2});
     }
 }
 

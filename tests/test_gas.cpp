@@ -124,10 +124,10 @@ struct gas_run {
 
 /// Runs the gas for `duration` seconds at dt_factor times the default step, sampling the energy
 /// and momentum `samples` times; counts collisions when asked (one snapshot per step).
-template <class Real>
+template <class Real, class Integrator>
 gas_run run_gas(double dt_factor, double duration, std::size_t samples, bool count_collisions)
 {
-    sphere::simulation<Real> sim(gas_settings<Real>(dt_factor), gas_particles<Real>(20240611u));
+    sphere::simulation<Real, sphere::host, sphere::contact::linear<>, Integrator> sim(gas_settings<Real>(dt_factor), gas_particles<Real>(20240611u));
     gas_run r;
     const auto first = sim.snapshot();
     double sum_mv = 0;
@@ -172,15 +172,16 @@ gas_run run_gas(double dt_factor, double duration, std::size_t samples, bool cou
 
 } // namespace
 
-TEMPLATE_TEST_CASE("D11 elastic gas conserves momentum and energy", "[gas][D11]", float, double)
+namespace {
+template <class Real, class Integrator>
+void check_d11()
 {
-    using Real = TestType;
     // Simulated time: 0.05 s. Kinetic theory: mean free path 1 / (sqrt 2 n pi d^2) = 0.047 m at
     // n = 1000 / 0.43756^3, mean speed sqrt(8 / pi) = 1.6 m/s, so ~34 collisions per particle
     // per second, ~850 pair collisions in all (plus the wall hits) in 0.05 s; ~950 are counted.
     const double duration = 0.05;
-    const gas_run coarse = run_gas<Real>(1.0, duration, 200, true);
-    const gas_run fine = run_gas<Real>(0.1, duration, 200, false);
+    const gas_run coarse = run_gas<Real, Integrator>(1.0, duration, 200, true);
+    const gas_run fine = run_gas<Real, Integrator>(0.1, duration, 200, false);
     INFO(std::setprecision(8) << "dt: " << coarse.steps << " steps (" << coarse.rebuilds << " list rebuilds), ~"
                               << coarse.collisions << " collisions, E0 = " << coarse.e0 << " J, energy drift "
                               << coarse.energy_drift << ", momentum drift " << coarse.momentum_drift);
@@ -209,4 +210,11 @@ TEMPLATE_TEST_CASE("D11 elastic gas conserves momentum and energy", "[gas][D11]"
     // to dt/10 in double (float reaches its round-off floor, ~1e-5, first). Ask for at least 5x,
     // half of what a first-order error would give.
     CHECK(fine.energy_drift * 5 < coarse.energy_drift);
+}
+} // namespace
+
+TEMPLATE_TEST_CASE("D11 elastic gas conserves momentum and energy", "[gas][D11]", float, double)
+{
+    SECTION("semi-implicit Euler (default)") { check_d11<TestType, sphere::integrate::semi_implicit_euler>(); }
+    SECTION("velocity Verlet") { check_d11<TestType, sphere::integrate::velocity_verlet>(); }
 }

@@ -127,15 +127,12 @@ reference_pairs brute_force(const sphere::particle_snapshot<Real>& s, const sphe
 }
 
 /// Compares the simulation's contact lists with the reference; returns a description of every
-/// discrepancy (empty when the lists are exact). Also checks the documented layout: entry k
-/// of particle i at i * capacity + k, at most `capacity` entries, sorted by partner index
-/// with no duplicates and no self-entry.
-template <class Lists>
-std::vector<std::string> compare_lists(const Lists& lists, const reference_pairs& ref)
+/// discrepancy (empty when the lists are exact). Also checks the documented layout: entries of
+/// particle i at [offset[i], offset[i + 1]), sorted by partner user index (walls last) with no
+/// duplicates and no self-entry.
+template <class Table>
+std::vector<std::string> compare_lists(const Table& lists, const reference_pairs& ref)
 {
-    const std::vector<unsigned> count = lists.counts();
-    const std::vector<unsigned> partner = lists.partners();
-    const std::size_t cap = lists.capacity();
     std::vector<std::string> bad;
     auto report = [&](std::size_t i, const std::string& what) {
         if (bad.size() < 20) {
@@ -147,14 +144,11 @@ std::vector<std::string> compare_lists(const Lists& lists, const reference_pairs
         }
     };
     for (std::size_t i = 0; i < ref.certain.size(); ++i) {
-        if (count[i] > cap) {
-            report(i, "count " + std::to_string(count[i]) + " exceeds the capacity");
-            continue;
-        }
+        for (std::size_t e = lists.begin(i) + 1; e < lists.end(i); ++e)
+            if (!(lists.partner[e - 1] < lists.partner[e]))
+                report(i, "list not strictly ascending at entry " + std::to_string(e - lists.begin(i)));
         std::set<unsigned> listed;
-        for (unsigned k = 0; k < count[i]; ++k) {
-            const unsigned j = partner[i * cap + k];
-            if (k > 0 && !(partner[i * cap + k - 1] < j)) report(i, "list not strictly ascending at entry " + std::to_string(k));
+        for (unsigned j : lists.partners_of(i)) {
             if (j == i) report(i, "lists itself");
             listed.insert(j);
         }
@@ -204,7 +198,6 @@ TEMPLATE_TEST_CASE("contact lists hold exactly the brute-force pairs within r_i 
                 s.box = cloud_box<Real>(l.periodic_x, l.periodic_y);
                 s.skin = static_cast<Real>(q.skin);
                 s.cell_size = static_cast<Real>(q.cell_size);
-                s.contact_capacity = 24;
                 sphere::simulation<Real> sim(s, random_cloud<Real>(s.box, seed));
 
                 const sphere::particle_snapshot<Real> snap = sim.snapshot();
@@ -236,7 +229,9 @@ TEMPLATE_TEST_CASE("contact lists hold exactly the brute-force pairs within r_i 
                 REQUIRE(bad.empty());
 
                 // The counts equal the reference's partner counts.
-                const std::vector<unsigned> count = sim.contacts().counts();
+                const sphere::contact_table<Real> table = sim.contacts();
+                std::vector<std::size_t> count(snap.size());
+                for (std::size_t i = 0; i < snap.size(); ++i) count[i] = table.partners_of(i).size();
                 std::size_t listed = 0, miscounted = 0;
                 for (std::size_t i = 0; i < snap.size(); ++i) {
                     listed += count[i];
@@ -265,7 +260,6 @@ std::pair<sphere::settings<Real>, std::vector<sphere::particle<Real>>> dense_ass
     const std::size_t n = 2000;
     const double half = 15 * r0;
     sphere::settings<Real> s = sphere_test::frictional_box<Real>(half);
-    s.contact_capacity = 24;
 
     std::mt19937 gen(seed);
     std::uniform_real_distribution<double> unit(0.0, 1.0);
@@ -372,13 +366,6 @@ std::vector<std::pair<unsigned, unsigned>> overlapping_pairs(const sphere::parti
     return out;
 }
 
-template <class Lists>
-bool listed(const Lists& count_partner, std::size_t cap, unsigned i, unsigned j)
-{
-    const unsigned* begin = count_partner.second.data() + i * cap;
-    return std::binary_search(begin, begin + count_partner.first[i], j);
-}
-
 } // namespace
 
 TEMPLATE_TEST_CASE("a skin skips rebuilds without changing the dynamics of a dense frictional assembly",
@@ -402,11 +389,10 @@ TEMPLATE_TEST_CASE("a skin skips rebuilds without changing the dynamics of a den
     for (std::size_t k = 0; k < steps; ++k) {
         no_skin.step();
         skin.step();
-        const auto lists = std::make_pair(skin.contacts().counts(), skin.contacts().partners());
+        const sphere::contact_table<Real> lists = skin.contacts();
         for (const auto& pr : overlapping) {
             ++checked;
-            if (!listed(lists, skin.contacts().capacity(), pr.first, pr.second) ||
-                !listed(lists, skin.contacts().capacity(), pr.second, pr.first))
+            if (lists.find(pr.first, pr.second) == ~std::size_t(0) || lists.find(pr.second, pr.first) == ~std::size_t(0))
                 ++missed;
         }
         overlapping = overlapping_pairs(skin.snapshot());
@@ -455,22 +441,17 @@ TEMPLATE_TEST_CASE("a skin skips rebuilds without changing the dynamics of a den
     // The tangential histories of the overlapping pairs agree too (the skin run carried them
     // over ~15 rebuilds, the skin-0 run over 400), and there are plenty of them: sticking
     // and sliding contacts with non-zero tangential displacement.
-    const std::size_t cap = s1.contact_capacity;
-    const auto c0 = no_skin.contacts().counts(), c1 = skin.contacts().counts();
-    const auto p0 = no_skin.contacts().partners(), p1 = skin.contacts().partners();
-    const auto h0 = no_skin.contacts().histories(), h1 = skin.contacts().histories();
+    const sphere::contact_table<Real> t0 = no_skin.contacts(), t1 = skin.contacts();
     double hdiff = 0, hscale = 0;
     std::size_t sliding = 0, sticking = 0, unmatched = 0;
     for (std::size_t i = 0; i < a.size(); ++i)
-        for (unsigned k = 0; k < c0[i]; ++k) {
-            const unsigned j = p0[i * cap + k];
-            const unsigned* begin = p1.data() + i * cap;
-            const unsigned* at = std::lower_bound(begin, begin + c1[i], j);
-            if (at == begin + c1[i] || *at != j) {
+        for (std::size_t e0 = t0.begin(i); e0 < t0.end(i); ++e0) {
+            const std::size_t e1 = t1.find(i, t0.partner[e0]);
+            if (e1 == ~std::size_t(0)) {
                 ++unmatched;
                 continue;
             }
-            const sphere::vec4<Real> u = h0[i * cap + k], w = h1[i * cap + (at - begin)];
+            const sphere::vec4<Real> u = t0.history[e0], w = t1.history[e1];
             const double du[4] = {double(u.x) - w.x, double(u.y) - w.y, double(u.z) - w.z, double(u.w) - w.w};
             for (double d : du) hdiff = std::max(hdiff, std::abs(d));
             hscale = std::max({hscale, std::abs(double(u.x)), std::abs(double(u.y)), std::abs(double(u.z))});
@@ -491,12 +472,9 @@ namespace {
 template <class Sim>
 int entry_of(const Sim& sim, unsigned i, unsigned j)
 {
-    const auto count = sim.contacts().counts();
-    const auto partner = sim.contacts().partners();
-    const std::size_t cap = sim.contacts().capacity();
-    for (unsigned k = 0; k < count[i] && k < cap; ++k)
-        if (partner[i * cap + k] == j) return static_cast<int>(k);
-    return -1;
+    const auto t = sim.contacts();
+    const std::size_t e = t.find(i, j);
+    return e == ~std::size_t(0) ? -1 : static_cast<int>(e - t.begin(i));
 }
 
 } // namespace
@@ -592,14 +570,13 @@ TEMPLATE_TEST_CASE("the tangential history of a contact survives rebuilds that r
         const int kb = entry_of(sim, ia, ib);
         REQUIRE(kb >= 0);
         entries_of_b.insert(kb);
-        const std::size_t others = sim.contacts().counts()[ia] - 1;
+        const std::size_t others = sim.contacts().partners_of(ia).size() - 1;
         others_listed = std::max(others_listed, others);
         if (others > 0) ++steps_with_others;
         const int ka = entry_of(sim, ib, ia);
         REQUIRE(ka >= 0);
-        const std::size_t cap = sim.contacts().capacity();
-        const auto h = sim.contacts().histories();
-        const sphere::vec4<Real> ha = h[ia * cap + kb], hb = h[ib * cap + ka];
+        const auto t = sim.contacts();
+        const sphere::vec4<Real> ha = t.history[t.begin(ia) + kb], hb = t.history[t.begin(ib) + ka];
         if (n + 20 < stick_steps) {
             // Sticking: delta_t = n dt v_t along +y on A, -y on B.
             const double expect = static_cast<double>(n) * dt * vt;
@@ -652,7 +629,7 @@ TEMPLATE_TEST_CASE("a particle given more than one period outside a periodic axi
         const auto snap = sim.snapshot();
         CHECK(snap.x[1].x >= s.box.lo.x);
         CHECK(snap.x[1].x < s.box.hi.x);
-        REQUIRE(sim.contacts().counts()[0] == 1);
+        REQUIRE(sim.contacts().partners_of(0) == std::vector<unsigned>{1});
         sim.step();
         // The overlap pushes particle 0 towards -x: f = k_n 1e-3 m = 100 N.
         CHECK(sim.snapshot().force[0].x == Approx(-100).epsilon(1e-3));

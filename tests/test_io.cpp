@@ -87,10 +87,10 @@ void require_identical(const sphere::simulation_state<Real>& a, const sphere::si
     CHECK(same_bits(p.p_visc, q.p_visc));
     CHECK(same_bits(p.p_fric, q.p_fric));
     CHECK(same_bits(p.kind, q.kind));
-    CHECK(same_bits(a.counts, b.counts));
-    CHECK(same_bits(a.partners, b.partners));
-    CHECK(same_bits(a.histories, b.histories));
-    CHECK(same_bits(a.wall_histories, b.wall_histories));
+    CHECK(same_bits(a.contacts.offset, b.contacts.offset));
+    CHECK(same_bits(a.contacts.partner, b.contacts.partner));
+    CHECK(same_bits(a.contacts.history, b.contacts.history));
+    CHECK(same_bits(a.storage, b.storage));
     CHECK(same_bits(a.x_at_build, b.x_at_build));
     CHECK(same_bits(a.drive_work, b.drive_work));
     for (int f = 0; f < 6; ++f) {
@@ -200,21 +200,14 @@ TEMPLATE_TEST_CASE("checkpoint restart continues bit-identically", "[io][checkpo
     require_identical(restarted.state(), original.state());
     CHECK(restarted.time() == original.time());
 
-    // The per-contact forces of the last step agree on every listed entry.
-    const auto fa = original.contacts().forces(), fb = restarted.contacts().forces();
-    const auto counts = original.contacts().counts();
-    const std::size_t cap = original.contacts().capacity();
-    bool forces_equal = true;
-    for (std::size_t i = 0; i < counts.size(); ++i)
-        for (std::size_t k = 0; k < counts[i] && k < cap; ++k) forces_equal &= same_bits(fa[i * cap + k], fb[i * cap + k]);
-    CHECK(forces_equal);
-    CHECK(same_bits(original.contacts().wall_forces(), restarted.contacts().wall_forces()));
+    // The per-contact forces of the last step agree on every listed entry, walls included.
+    CHECK(same_bits(original.contacts().force, restarted.contacts().force));
 
     // The comparison means something: at the checkpoint particles touched with tangential
     // history, and afterwards the lists were rebuilt, particles slid, and the top wall moved
     // down onto the particles (it started at 0.04 m) and carries a force.
     bool history = false;
-    for (const vec4<Real>& h : at_checkpoint.histories) history |= h.x != 0 || h.y != 0 || h.z != 0;
+    for (const vec4<Real>& h : at_checkpoint.contacts.history) history |= h.x != 0 || h.y != 0 || h.z != 0;
     CHECK(history);
     CHECK(original.rebuilds() > rebuilds_before + 1);
     double e_fric = 0;
@@ -253,9 +246,10 @@ TEMPLATE_TEST_CASE("checkpoints convert between float and double", "[io][checkpo
     CHECK(same_bits(c.state.particles.torque, map(s.particles.torque, cast3)));
     CHECK(same_bits(c.state.particles.mass, map(s.particles.mass, scalar)));
     CHECK(same_bits(c.state.particles.e_fric, map(s.particles.e_fric, scalar)));
-    CHECK(same_bits(c.state.histories, map(s.histories, cast4)));
-    CHECK(same_bits(c.state.wall_histories, map(s.wall_histories, cast4)));
-    CHECK(same_bits(c.state.partners, s.partners));
+    CHECK(same_bits(c.state.contacts.history, map(s.contacts.history, cast4)));
+    CHECK(same_bits(c.state.contacts.partner, s.contacts.partner));
+    CHECK(same_bits(c.state.contacts.offset, s.contacts.offset));
+    CHECK(same_bits(c.state.storage, s.storage));
     CHECK(c.config.dt == Other(original.dt()));
     CHECK(c.config.walls[5].amplitude == Other(original.config().walls[5].amplitude));
     CHECK(c.config.skin == Other(original.config().skin));
@@ -292,19 +286,18 @@ TEMPLATE_TEST_CASE("a writer killed while writing leaves the previous checkpoint
     sphere::write_checkpoint(path, small);
     const std::string previous_bytes = read_bytes(path);
 
-    // A large checkpoint (20^3 particles, 96 contact entries each: about 30 MB) that takes
-    // long enough to write that the kill lands inside the write.
+    // A large checkpoint (40^3 particles on a touching lattice, 6 contact entries each: about
+    // 27 MB) that takes long enough to write that the kill lands inside the write.
     sphere::settings<Real> big_settings = eventful_settings<Real>();
-    big_settings.box.lo = {Real(-0.25), Real(-0.25), Real(-0.25)};
-    big_settings.box.hi = {Real(0.25), Real(0.25), Real(0.25)};
+    big_settings.box.lo = {Real(-0.45), Real(-0.45), Real(-0.45)};
+    big_settings.box.hi = {Real(0.45), Real(0.45), Real(0.45)};
     big_settings.walls[5] = sphere::wall_control<Real>{};
-    big_settings.contact_capacity = 96;
     std::vector<sphere::particle<Real>> many;
-    for (int k = 0; k < 20; ++k)
-        for (int j = 0; j < 20; ++j)
-            for (int i = 0; i < 20; ++i)
-                many.push_back(sphere_test::ball<Real>({Real(-0.2 + 0.021 * i), Real(-0.2 + 0.021 * j),
-                                                        Real(-0.2 + 0.021 * k)}));
+    for (int k = 0; k < 40; ++k)
+        for (int j = 0; j < 40; ++j)
+            for (int i = 0; i < 40; ++i)
+                many.push_back(sphere_test::ball<Real>({Real(-0.4 + 0.0199 * i), Real(-0.4 + 0.0199 * j),
+                                                        Real(-0.4 + 0.0199 * k)}));
     const host_sim<Real> big(big_settings, many);
     const std::size_t big_size = sphere::encode_checkpoint(big.config(), big.dt(), big.state()).size();
     REQUIRE(big_size > 20u * 1000 * 1000);
@@ -398,30 +391,32 @@ TEMPLATE_TEST_CASE("broken checkpoints raise the documented errors", "[io][check
             std::memcpy(&d, &v, 8);
             return d;
         };
-        const std::uint64_t n = 64, cap = sim.config().contact_capacity;
+        const std::uint64_t n = 64, entries = sim.state().contacts.partner.size();
         CHECK(bytes.compare(0, 8, "SPHERECK") == 0);
-        CHECK(u32_at(8) == 2);
+        CHECK(u32_at(8) == 3);
         CHECK(u32_at(12) == sizeof(Real));
         CHECK(u64_at(16) == size - 32);
-        CHECK(size == 976 + 477 * n + 36 * n * cap);
+        CHECK(size == 1032 + 289 * n + 36 * entries);
         CHECK(f64_at(24 + 40) == double(sim.config().box.hi.z)); // box.hi = payload bytes 24-47
         CHECK(u32_at(24 + 48) == 0); // box.axis[0]: wall
         CHECK(f64_at(24 + 60) == double(sim.config().contact.k_n));
-        CHECK(f64_at(24 + 112 + 32) == double(sim.config().wall.mu_s));
-        CHECK(f64_at(24 + 164 + 16) == double(sim.config().gravity.z));
-        CHECK(f64_at(24 + 188) == double(sim.dt()));
-        CHECK(f64_at(24 + 196) == double(sim.config().skin));
-        CHECK(u64_at(24 + 204) == cap);
-        CHECK(u32_at(24 + 220 + 5 * 52) == 2); // walls[5].mode: stress
-        CHECK(f64_at(24 + 220 + 5 * 52 + 4 + 16) == double(sim.config().walls[5].amplitude));
-        CHECK(u64_at(24 + 532) == n);
-        CHECK(u64_at(24 + 540) == 100); // steps
-        CHECK(u64_at(24 + 548) == sim.rebuilds());
-        CHECK(u32_at(24 + 560 + 5 * 36) == 1); // face 5 active
-        CHECK(f64_at(24 + 560 + 5 * 36 + 4) == double(sim.walls().face[5].position));
-        CHECK(f64_at(24 + 776) == sim.drive_work());
-        CHECK(u64_at(24 + 784) == n); // the positions' count
-        CHECK(f64_at(24 + 784 + 8 + 3 * 8) == double(sim.snapshot().x[0].w)); // particle 0's radius
+        CHECK(f64_at(24 + 116 + 32) == double(sim.config().wall.mu_s));
+        CHECK(f64_at(24 + 172 + 16) == double(sim.config().gravity.z));
+        CHECK(f64_at(24 + 196) == double(sim.dt()));
+        CHECK(f64_at(24 + 204) == double(sim.config().skin));
+        CHECK(u32_at(24 + 212) == 1); // contact_forces
+        CHECK(u32_at(24 + 216) == 1); // energy_audit
+        CHECK(u32_at(24 + 228 + 5 * 52) == 2); // walls[5].mode: stress
+        CHECK(f64_at(24 + 228 + 5 * 52 + 4 + 16) == double(sim.config().walls[5].amplitude));
+        CHECK(u64_at(24 + 540) == n);
+        CHECK(u64_at(24 + 548) == 100); // steps
+        CHECK(u64_at(24 + 556) == sim.rebuilds());
+        CHECK(u32_at(24 + 568 + 5 * 36) == 1); // face 5 active
+        CHECK(f64_at(24 + 568 + 5 * 36 + 4) == double(sim.walls().face[5].position));
+        CHECK(f64_at(24 + 784 + 5 * 8) == double(sim.state().walls_at_build.face[5].position));
+        CHECK(f64_at(24 + 832) == sim.drive_work());
+        CHECK(u64_at(24 + 840) == n); // the positions' count
+        CHECK(f64_at(24 + 840 + 8 + 3 * 8) == double(sim.snapshot().x[0].w)); // particle 0's radius
     }
     SECTION("missing")
     {
@@ -476,26 +471,34 @@ TEMPLATE_TEST_CASE("broken checkpoints raise the documented errors", "[io][check
     SECTION("wrong version")
     {
         std::string b = bytes;
-        REQUIRE(b[8] == 2); // the version, little-endian u32 at byte 8
-        b[8] = 1;
+        REQUIRE(b[8] == 3); // the version, little-endian u32 at byte 8
+        b[8] = 2;
         write_bytes(bad, b);
         REQUIRE_THROWS_WITH(sphere::read_checkpoint<Real>(bad),
-                            where + "format version 1, but this build reads version 2 only");
+                            where + "format version 2, but this build reads version 3 only");
     }
     SECTION("sizes that do not fit the particle count")
     {
-        // A well-formed, correctly checksummed file whose contact counts miss one particle.
+        // A well-formed, correctly checksummed file whose storage order misses one particle.
         sphere::simulation_state<Real> s = sim.state();
-        s.counts.pop_back();
+        s.storage.pop_back();
         write_bytes(bad, sphere::encode_checkpoint(sim.config(), sim.dt(), s));
         REQUIRE_THROWS_WITH(sphere::read_checkpoint<Real>(bad),
-                            where + "inconsistent contents: the contact counts: 63 entries, expected 64");
+                            where + "inconsistent contents: the storage order: 63 entries, expected 64");
         s = sim.state();
-        s.partners[0] = 64; // particle 0's first partner: there is no particle 64
-        s.counts[0] = s.counts[0] == 0 ? 1 : s.counts[0];
+        std::size_t i0 = 0;
+        while (s.contacts.begin(i0) == s.contacts.end(i0)) ++i0; // the first particle with an entry
+        s.contacts.partner[s.contacts.begin(i0)] = 64; // there is no particle 64
         write_bytes(bad, sphere::encode_checkpoint(sim.config(), sim.dt(), s));
         REQUIRE_THROWS_WITH(sphere::read_checkpoint<Real>(bad),
-                            where + "inconsistent contents: particle 0 lists partner 64 (64 particles)");
+                            where + "inconsistent contents: particle " + std::to_string(i0) +
+                                " lists partner 64 (64 particles, or an active wall face)");
+        s = sim.state();
+        s.storage[0] = s.storage[1];
+        write_bytes(bad, sphere::encode_checkpoint(sim.config(), sim.dt(), s));
+        REQUIRE_THROWS_WITH(sphere::read_checkpoint<Real>(bad),
+                            where + "inconsistent contents: the storage order is not a permutation: slot 1 holds particle " +
+                                std::to_string(s.storage[1]));
     }
 }
 

@@ -356,8 +356,11 @@ poured pour(std::size_t n, double width_d, double mu, double kappa, double dt_fa
         out.top = std::max(out.top, double(snap.x[i].z) + double(snap.x[i].w));
         out.weight += double(snap.mass[i]) * g;
     }
-    const std::vector<sphere::vec3<Real>> wf = sim.contacts().wall_forces();
-    for (std::size_t i = 0; i < n; ++i) out.floor_force += double(wf[i * 6 + 4].z);
+    const sphere::contact_table<Real> t = sim.contacts();
+    for (std::size_t i = 0; i < n; ++i) {
+        const std::size_t e = t.find(i, sphere::wall_partner_base + 4); // the floor, face 4
+        if (e != ~std::size_t(0)) out.floor_force += double(t.force[e].w); // f_n . n, n = +z
+    }
     const sphere::porosity_result core =
         sphere::porosity_in_box(snap.x, s.box, {0, 0, 3 * d}, {width, width, out.top - 4 * d});
     out.core_fraction = 1 - core.porosity;

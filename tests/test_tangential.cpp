@@ -560,7 +560,6 @@ TEMPLATE_TEST_CASE("D9 rigid rotation of a stretched contact and a new contact",
             const vec3<double> c = (xa + xb) * 0.5;
             const double half = norm(xb - xa) / 2;
             const double dth = pi_d / 2 / static_cast<double>(steps);
-            const std::size_t cap = pair.sim.contacts().capacity();
             double ft_err = 0, normal_part = 0, turn_err = 0;
             for (std::size_t k = 1; k <= steps; ++k) {
                 const auto p = pair.sim.snapshot();
@@ -578,8 +577,9 @@ TEMPLATE_TEST_CASE("D9 rigid rotation of a stretched contact and a new contact",
                 ft_err = std::max(ft_err, rel_err(norm(ftb), ft_ref));
                 turn_err = std::max(turn_err, 1 - dot(ftb, tp * -1.0) / norm(ftb));
                 // f_t = -k_t delta_t (gamma_t = 0, sticking): the library's delta_t of B's contact
-                // (B's only partner, entry 1 * capacity + 0) must lie in the contact plane.
-                const auto h = pair.sim.contacts().histories()[1 * cap + 0];
+                // (B's entry for partner A) must lie in the contact plane.
+                const auto t = pair.sim.contacts();
+                const auto h = t.history[t.find(1, 0)];
                 const vec3<double> d{static_cast<double>(h.x), static_cast<double>(h.y), static_cast<double>(h.z)};
                 normal_part = std::max(normal_part, std::abs(dot(d, np)) / norm(d));
             }

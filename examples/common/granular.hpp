@@ -79,6 +79,18 @@ sphere::contact_params<Real> contact_of(const sample_options& o)
     return c;
 }
 
+/// The particle-wall contact parameters of the examples with walls on the sides: those of
+/// contact_of, and a tangential viscosity gamma_t = gamma_n, so that the walls' friction acts
+/// (the wall law is viscous-frictional, sphere's: with gamma_t = 0 it has no tangential force,
+/// whatever mu; a grain spinning in a corner of frictionless walls would never stop).
+template <class Real>
+sphere::contact_params<Real> frictional_wall_of(const sample_options& o)
+{
+    sphere::contact_params<Real> c = contact_of<Real>(o);
+    c.gamma_t = c.gamma_n;
+    return c;
+}
+
 /// A sample poured under gravity (-z, 9.81 m/s^2) and come to rest (kinetic energy below
 /// 1e-4 of n m g d: low enough for a packing whose grains have stopped falling, high enough
 /// that one grain still rolling on the bottom wall, which nothing slows down in the absence of

@@ -19,7 +19,17 @@ struct settings {
     vec3<Real> gravity{0, 0, 0};    ///< (m/s^2)
     Real dt = 0;                    ///< time step (s); 0 selects 0.075 min sqrt(m / max(k_n, k_t))
     Real skin = 0;                  ///< contact-list skin (m); 0 rebuilds the lists every step, as sphere
-    std::size_t contact_capacity = 32; ///< partners listed per particle (within r_i + r_j + skin)
+    /// Keep each contact's force of the last step (for the stress and contact-network analyses
+    /// of analysis/stress.cuh); off saves 32 B (double) per listed pair and their stores.
+    bool contact_forces = true;
+    /// Book each particle's contact pressure, dissipation rates and dissipated energies every
+    /// step, so that energy().total() closes; off leaves them at zero and saves their work.
+    bool energy_audit = true;
+    /// Store the particles in the neighbour grid's cell order, permuted at every rebuild (nearby
+    /// particles sit nearby in memory: about 2x faster on a large, spatially unsorted input);
+    /// false keeps the user's order. Results do not depend on it, except through sums over all
+    /// particles (the wall forces, which stress-controlled walls feed back: docs/architecture.md).
+    bool reorder = true;
     Real cell_size = 0;             ///< neighbour-grid cell width (m); 0 selects the largest diameter plus skin
     /// Motion of each wall face f (axis f / 2, lower face when f is even; the upper wall is
     /// walls[5]); all fixed by default.

@@ -3,6 +3,7 @@
 /// `simulation`: composes particles, the neighbour grid, the contact lists, a contact law and
 /// an integrator into sphere's DEM step, with observers and diagnostics.
 #include <cmath>
+#include <algorithm>
 #include <cstddef>
 #include <functional>
 #include <utility>
@@ -28,50 +29,29 @@
 namespace sphere {
 
 namespace detail {
-/// What the particles do to the boundaries in one step: their forces on the six walls along
-/// the axes (N) and the power of the agent that drives the prescribed particles (W), both
-/// summed in double.
-struct boundary_loads {
-    double wall_force[6];
-    double drive_power;
-    SPHERE_HD boundary_loads operator+(const boundary_loads& b) const
-    {
-        boundary_loads out;
-        for (int k = 0; k < 6; ++k) out.wall_force[k] = wall_force[k] + b.wall_force[k];
-        out.drive_power = drive_power + b.drive_power;
-        return out;
-    }
-};
-
-/// Particle i's share of the boundary loads, after integration. The agent that keeps a
-/// prescribed particle on its course cancels whatever the contacts and gravity would change:
-/// its force is m a - f - m g and its torque -t (a = 0 for motion::prescribed, a = f_z / m
-/// along z for motion::prescribed_horizontal), and its power is their product with the
-/// velocities at the positions' time (docs/physics.md, "Driven particles").
+/// The power (W) of the agent that keeps prescribed particle i on its course, after
+/// integration. The agent cancels whatever the contacts and gravity would change: its force is
+/// m a - f - m g and its torque -t (a = 0 for motion::prescribed, a = f_z / m along z for
+/// motion::prescribed_horizontal), and its power is their product with the velocities at the
+/// positions' time (docs/physics.md, "Driven particles").
 template <class Real>
-struct particle_boundary_loads {
+struct drive_power {
     particle_view<Real> p;
-    const vec3<Real>* wall_force; ///< force of face f on particle i, at [i * 6 + f]
     vec3<Real> gravity;
-    SPHERE_HD boundary_loads operator()(std::size_t i) const
+    SPHERE_HD double operator()(std::size_t i) const
     {
-        boundary_loads out;
-        for (int k = 0; k < 6; ++k) out.wall_force[k] = -double(wall_force[i * 6 + k][k / 2]);
-        out.drive_power = 0;
         const auto kind = static_cast<motion>(p.kind[i]);
-        if (kind == motion::prescribed || kind == motion::prescribed_horizontal) {
-            vec3<Real> agent = -(p.force[i] + gravity * p.mass[i]);
-            if (kind == motion::prescribed_horizontal) agent.z = -gravity.z * p.mass[i];
-            out.drive_power = double(dot(agent, p.v_sync[i])) - double(dot(p.torque[i], p.omega_sync[i]));
-        }
-        return out;
+        if (kind != motion::prescribed && kind != motion::prescribed_horizontal) return 0;
+        vec3<Real> agent = -(p.force[i] + gravity * p.mass[i]);
+        if (kind == motion::prescribed_horizontal) agent.z = -gravity.z * p.mass[i];
+        return double(dot(agent, p.v_sync[i])) - double(dot(p.torque[i], p.omega_sync[i]));
     }
 };
 
 template <class Real>
 struct set_kinematics {
     particle_view<Real> p;
-    std::size_t index;
+    std::size_t index; ///< storage slot
     vec3<Real> v, omega;
     SPHERE_HD void operator()(std::size_t) const
     {
@@ -86,11 +66,12 @@ struct set_kinematics {
 /// Everything of a simulation that evolves in time (the settings and the time step stay).
 template <class Real>
 struct simulation_state {
-    particle_snapshot<Real> particles;
-    std::vector<unsigned> counts, partners;           ///< contact lists (contact_lists layout)
-    std::vector<vec4<Real>> histories, wall_histories; ///< their history entries
-    std::vector<vec4<Real>> x_at_build;               ///< positions when the lists were built
+    particle_snapshot<Real> particles;  ///< in user order
+    contact_table<Real> contacts;        ///< the contact lists and their history (forces left out)
+    std::vector<vec4<Real>> x_at_build; ///< positions when the lists were built, in user order
+    std::vector<unsigned> storage;       ///< the user index of each storage slot (the storage order)
     wall_set<Real> walls;
+    wall_set<Real> walls_at_build; ///< the walls when the lists were built
     double drive_work = 0; ///< work done on the prescribed particles so far (J)
     std::size_t steps = 0, rebuilds = 0;
     bool needs_rebuild = false;
@@ -101,13 +82,16 @@ struct simulation_state {
 /// \tparam Real       float or double
 /// \tparam Policy     sphere::host or sphere::cuda
 /// \tparam Law        contact law policy, e.g. contact::linear<tangential::visco_frictional>
-/// \tparam Integrator integrate::semi_implicit_euler (default), taylor2 or explicit_euler
+/// \tparam Integrator integrate::semi_implicit_euler (default), velocity_verlet, taylor2 or
+///                    explicit_euler
 ///
 /// One step: rebuild the grid and contact lists when some particle has moved more than half
-/// the skin since the last rebuild (every step with skin 0); every particle gathers contact
-/// forces; integrate; check every particle (a non-finite value or a particle outside the world
-/// on a wall axis stops the run with a sphere::error naming the step and the particle); advance
-/// time; call the observers that are due.
+/// the skin since the last rebuild (every step with skin 0), permuting the particles into the
+/// grid's cell order; every particle gathers contact forces; integrate; check every particle (a
+/// non-finite value or a particle outside the world on a wall axis stops the run with a
+/// sphere::error naming the step and the particle's user index); advance time; call the
+/// observers that are due. Velocity Verlet drifts the particles first and checks them before
+/// the forces (docs/architecture.md, "One step").
 template <class Real, class Policy = host, class Law = contact::linear<>,
           class Integrator = integrate::semi_implicit_euler>
 class simulation {
@@ -125,7 +109,6 @@ public:
             detail::fail("settings.gravity (", s.gravity.x, ", ", s.gravity.y, ", ", s.gravity.z, ") m/s^2 is not finite");
         if (!(s.skin >= 0) || !std::isfinite(s.skin))
             detail::fail("settings.skin = ", s.skin, " m: must be non-negative and finite");
-        if (s.contact_capacity < 1) detail::fail("settings.contact_capacity = 0: must be at least 1");
         if (!(s.cell_size >= 0) || !std::isfinite(s.cell_size))
             detail::fail("settings.cell_size = ", s.cell_size, " m: must be non-negative and finite (0 = automatic)");
         validate_wall_controls(s.walls, s.box);
@@ -153,37 +136,42 @@ public:
         }
 
         particles_ = particle_state<Real, Policy>(particles);
-        for (const particle<Real>& p : particles) kinds_.push_back(p.kind);
+        for (const particle<Real>& p : particles) {
+            kinds_.push_back(p.kind);
+            if (p.kind == motion::prescribed || p.kind == motion::prescribed_horizontal) drive_ = true;
+        }
         walls_ = wall_set<Real>::from_world(s.box);
         grid_ = neighbor_grid<Real, Policy>(grid_geometry<Real>::make(s.box, 2 * max_radius + s.skin, s.cell_size));
-        lists_ = contact_lists<Real, Policy>(particles.size(), s.contact_capacity);
+        lists_ = contact_lists<Real, Policy>(particles.size(), s.contact_forces);
         x_at_build_.resize(particles.size());
         rebuild_lists();
+        // An integrator that kicks before the forces needs the forces of the start.
+        if (Integrator::drifts_before_forces) interact(false);
     }
 
     /// One DEM step of length dt().
     void step()
     {
-        if (needs_rebuild_) rebuild_lists();
-        particle_view<Real> p = particles_.view();
+        const particle_view<Real> p = particles_.view();
         const std::size_t n = p.n;
-        for_each_index(Policy{}, n,
-                       detail::interact<Real, Law>{p, lists_.view(), settings_.box, walls_, settings_.contact,
-                                                   settings_.wall, dt_});
-        for_each_index(Policy{}, n, detail::integrate_particles<Real, Integrator>{p, settings_.box, settings_.gravity, dt_,
-                                                                             external_.size() ? external_.data() : nullptr});
-        const detail::boundary_loads loads =
-            transform_reduce(Policy{}, n, detail::particle_boundary_loads<Real>{p, lists_.view().wall_force, settings_.gravity},
-                             detail::boundary_loads{}, plus_op{});
-        advance_walls(walls_, settings_.walls, settings_.box, loads.wall_force, time_, dt_, steps_ + 1);
-        drive_work_ += loads.drive_power * double(dt_);
-        const detail::step_check<Real> check = transform_reduce(
-            Policy{}, n, detail::check_particle<Real>{p, x_at_build_.data(), settings_.box, walls_},
-            detail::step_check<Real>{0, ~std::size_t(0)}, detail::combine_checks{});
+        const vec3<Real>* external = external_.size() ? external_.data() : nullptr;
+        if constexpr (Integrator::drifts_before_forces) {
+            for_each_index(Policy{}, n,
+                           detail::drift_particles<Real, Integrator>{p, settings_.box, settings_.gravity, dt_, external});
+            check_particles(steps_ + 1);
+        }
+        if (needs_rebuild_) rebuild_lists();
+        const detail::wall_loads loads = interact(true);
+        const particle_view<Real> q = particles_.view(); // the rebuild may have permuted the particles
+        for_each_index(Policy{}, n, detail::integrate_particles<Real, Integrator>{q, settings_.box, settings_.gravity, dt_,
+                                                                               external_.size() ? external_.data() : nullptr});
+        advance_walls(walls_, settings_.walls, settings_.box, loads.force, time_, dt_, steps_ + 1);
+        if (drive_)
+            drive_work_ += transform_reduce(Policy{}, n, detail::drive_power<Real>{q, settings_.gravity}, 0.0, plus_op{}) *
+                           double(dt_);
         ++steps_;
         time_ = static_cast<double>(steps_) * static_cast<double>(dt_);
-        if (check.first_bad != ~std::size_t(0)) report_bad_particle(check.first_bad);
-        needs_rebuild_ = 4 * check.max_displacement2 > settings_.skin * settings_.skin;
+        if constexpr (!Integrator::drifts_before_forces) check_particles(steps_);
         for (const auto& o : observers_)
             if (steps_ % o.first == 0) o.second(*this);
     }
@@ -211,7 +199,9 @@ public:
         if (!isfinite(v) || !isfinite(omega))
             detail::fail("set_velocity: particle ", i, ": velocity (", v.x, ", ", v.y, ", ", v.z,
                          ") m/s or angular velocity (", omega.x, ", ", omega.y, ", ", omega.z, ") rad/s is not finite");
-        for_each_index(Policy{}, 1, detail::set_kinematics<Real>{particles_.view(), i, v, omega});
+        const std::vector<unsigned> user = particles_.user_indices();
+        const std::size_t slot = static_cast<std::size_t>(std::find(user.begin(), user.end(), unsigned(i)) - user.begin());
+        for_each_index(Policy{}, 1, detail::set_kinematics<Real>{particles_.view(), slot, v, omega});
     }
 
     /// Changes how wall face f moves from the next step on (e.g. from consolidation at a
@@ -268,15 +258,20 @@ public:
     double drive_work() const { return drive_work_; }
     const grid_geometry<Real>& grid() const { return grid_.geometry(); }
 
-    /// A host copy of every particle field.
+    /// A host copy of every particle field, in user order.
     particle_snapshot<Real> snapshot() const { return particles_.snapshot(); }
-    const contact_lists<Real, Policy>& contacts() const { return lists_; }
+    /// A host copy of the contact lists, in user order (forces only with settings.contact_forces).
+    contact_table<Real> contacts() const { return lists_.table(particles_.user_indices()); }
+    /// Entries in the contact lists (pairs from both sides, and wall entries).
+    std::size_t contact_entries() const { return lists_.entries(); }
 
-    /// Kernel view of the particle fields (policy memory, user order), for couplings that read
-    /// positions and velocities between steps (the pore fluid). Writing through it is undefined.
+    /// Kernel view of the particle fields (policy memory, storage order: `user` names each
+    /// slot's particle), for couplings that read positions and velocities between steps (the
+    /// pore fluid). The storage order changes at rebuilds. Writing through it is undefined.
     particle_view<Real> particle_data() { return particles_.view(); }
 
-    /// External forces on the particles (N; policy memory, one per particle in user order), added
+    /// External forces on the particles (N; policy memory, one per particle in storage order, which the
+    /// simulation keeps in step with the particles when it reorders them), added
     /// to the contact force of every free particle at each step until overwritten; zero until
     /// written. The pore-fluid coupling writes them (docs/fluid.md, *Coupling*). Their work is
     /// not part of energy().boundary_work (the coupling books it: work_on_particles()).
@@ -305,9 +300,23 @@ public:
     /// continues bit-identically.
     simulation_state<Real> state() const
     {
-        return {particles_.snapshot(),  lists_.counts(), lists_.partners(), lists_.histories(),
-                lists_.wall_histories(), x_at_build_.to_host(), walls_,         drive_work_,
-                steps_,                 rebuilds_,       needs_rebuild_};
+        const std::vector<unsigned> user = particles_.user_indices();
+        contact_table<Real> contacts = lists_.table(user);
+        contacts.force.clear();
+        std::vector<vec4<Real>> slots = x_at_build_.to_host(), x_at_build(slots.size());
+        for (std::size_t k = 0; k < slots.size(); ++k) x_at_build[user[k]] = slots[k];
+        simulation_state<Real> st;
+        st.particles = particles_.snapshot();
+        st.contacts = std::move(contacts);
+        st.x_at_build = std::move(x_at_build);
+        st.storage = user;
+        st.walls = walls_;
+        st.walls_at_build = walls_at_build_;
+        st.drive_work = drive_work_;
+        st.steps = steps_;
+        st.rebuilds = rebuilds_;
+        st.needs_rebuild = needs_rebuild_;
+        return st;
     }
 
     /// Continues from a state taken from a simulation with the same settings and particle count,
@@ -322,10 +331,29 @@ public:
                 detail::fail("restore: particle ", i, " has motion kind ", unsigned(s.particles.kind[i]), ", at most ",
                              unsigned(last_motion), " is valid");
         for (std::size_t i = 0; i < size(); ++i) kinds_[i] = static_cast<motion>(s.particles.kind[i]);
+        if (s.x_at_build.size() != size())
+            detail::fail("restore: the state holds ", s.x_at_build.size(), " build positions for ", size(), " particles");
+        for (std::size_t i = 0; i < size(); ++i)
+            if (static_cast<motion>(s.particles.kind[i]) == motion::prescribed ||
+                static_cast<motion>(s.particles.kind[i]) == motion::prescribed_horizontal)
+                drive_ = true;
+        if (s.storage.size() != size())
+            detail::fail("restore: the state's storage order has ", s.storage.size(), " entries for ", size(), " particles");
+        std::vector<char> seen(size(), 0);
+        for (std::size_t k = 0; k < size(); ++k) {
+            if (s.storage[k] >= size() || seen[s.storage[k]])
+                detail::fail("restore: the state's storage order is not a permutation (slot ", k, " holds ", s.storage[k], ")");
+            seen[s.storage[k]] = 1;
+        }
+        particles_.set_storage_order(s.storage);
         particles_.restore(s.particles);
-        lists_.restore(s.counts, s.partners, s.histories, s.wall_histories);
-        x_at_build_.assign(s.x_at_build);
+        const std::vector<unsigned> user = particles_.user_indices();
+        lists_.restore(s.contacts, user);
+        std::vector<vec4<Real>> slots(size());
+        for (std::size_t k = 0; k < size(); ++k) slots[k] = s.x_at_build[user[k]];
+        x_at_build_.assign(slots);
         walls_ = s.walls;
+        walls_at_build_ = s.walls_at_build;
         drive_work_ = s.drive_work;
         steps_ = s.steps;
         rebuilds_ = s.rebuilds;
@@ -342,28 +370,71 @@ public:
     }
 
 private:
+    /// Hashes the particles into the grid, builds the new lists (carrying the history over by
+    /// user index) and permutes every per-particle array into the grid's cell order.
     void rebuild_lists()
     {
-        particle_view<Real> p = particles_.view();
-        grid_.build(p);
-        const std::size_t overflow = lists_.rebuild(grid_.view(), settings_.skin);
-        ++rebuilds_;
-        if (overflow != ~std::size_t(0))
-            detail::fail("step ", steps_, ": particle ", overflow, " has ", lists_.count_of(overflow),
-                         " neighbours within r_i + r_j + skin, more than settings.contact_capacity = ",
-                         lists_.capacity(), "; raise the capacity");
+        grid_.build(particles_.view());
+        const grid_view<Real> g = grid_.view();
+        lists_.rebuild(g, walls_, settings_.skin, particles_.view().user, !settings_.reorder);
+        if (settings_.reorder) {
+            particles_.permute(g.order);
+            if (external_.size()) particles_.permute_along(external_, g.order);
+        }
+        const particle_view<Real> p = particles_.view();
         for_each_index(Policy{}, p.n, detail::copy_positions<Real>{p.x, x_at_build_.data()});
+        walls_at_build_ = walls_;
+        ++rebuilds_;
         needs_rebuild_ = false;
     }
 
-    [[noreturn]] void report_bad_particle(std::size_t i) const
+    /// Every particle's contact forces, with the switches of the settings; returns the wall
+    /// loads. `update` = false leaves histories and dissipation as they are.
+    detail::wall_loads interact(bool update)
+    {
+        if (settings_.energy_audit)
+            return settings_.contact_forces ? interact_with<true, true>(update) : interact_with<true, false>(update);
+        return settings_.contact_forces ? interact_with<false, true>(update) : interact_with<false, false>(update);
+    }
+
+    template <bool Book, bool Record>
+    detail::wall_loads interact_with(bool update)
+    {
+        const particle_view<Real> p = particles_.view();
+        return transform_reduce(Policy{}, p.n,
+                                detail::interact<Real, Law, Book, Record, Integrator::drifts_before_forces>{
+                                    p, lists_.view(), settings_.box, walls_, settings_.contact, settings_.wall, dt_,
+                                    update},
+                                detail::wall_loads{{0, 0, 0, 0, 0, 0}}, plus_op{});
+    }
+
+    /// The post-motion check of every particle (a sphere::error naming step `step` and the
+    /// particle); marks the lists for a rebuild when a particle and a wall may have come closer
+    /// than the skin.
+    void check_particles(std::size_t step)
+    {
+        const particle_view<Real> p = particles_.view();
+        const detail::step_check<Real> check = transform_reduce(
+            Policy{}, p.n, detail::check_particle<Real>{p, x_at_build_.data(), settings_.box, walls_},
+            detail::step_check<Real>{0, ~std::size_t(0)}, detail::combine_checks{});
+        if (check.first_bad != ~std::size_t(0)) report_bad_particle(check.first_bad, step);
+        const double moved = std::sqrt(double(check.max_displacement2)), skin = double(settings_.skin);
+        bool rebuild = 2 * moved > skin;
+        for (int f = 0; f < wall_set<Real>::count; ++f)
+            if (walls_.face[f].active && std::fabs(walls_.face[f].position - walls_at_build_.face[f].position) + moved > skin)
+                rebuild = true;
+        needs_rebuild_ = needs_rebuild_ || rebuild;
+    }
+
+    /// Throws the error for particle i (a user index) at step `step`.
+    [[noreturn]] void report_bad_particle(std::size_t i, std::size_t step) const
     {
         const particle_snapshot<Real> s = particles_.snapshot();
         const vec3<Real> x = s.position(i), v = s.v_sync[i];
         if (!isfinite(x) || !isfinite(v) || !isfinite(s.omega_sync[i]))
-            detail::fail("step ", steps_, ": particle ", i, " became non-finite (position (", x.x, ", ", x.y, ", ",
+            detail::fail("step ", step, ": particle ", i, " became non-finite (position (", x.x, ", ", x.y, ", ",
                          x.z, ") m, velocity (", v.x, ", ", v.y, ", ", v.z, ") m/s); reduce the time step");
-        detail::fail("step ", steps_, ": particle ", i, " left the world: position (", x.x, ", ", x.y, ", ", x.z,
+        detail::fail("step ", step, ": particle ", i, " left the world: position (", x.x, ", ", x.y, ", ", x.z,
                      ") m, world [", settings_.box.lo.x, ", ", settings_.box.hi.x, "] x [", settings_.box.lo.y, ", ",
                      settings_.box.hi.y, "] x [", settings_.box.lo.z, ", ", settings_.box.hi.z,
                      "] m, walls at x [", walls_.face[0].position, ", ", walls_.face[1].position, "], y [",
@@ -382,6 +453,8 @@ private:
     neighbor_grid<Real, Policy> grid_;
     contact_lists<Real, Policy> lists_;
     buffer<vec4<Real>, Policy> x_at_build_;
+    wall_set<Real> walls_at_build_;       ///< the walls when the lists were built
+    bool drive_ = false;                  ///< some particle is prescribed: book the drive's work
     buffer<vec3<Real>, Policy> external_; ///< external forces (empty until external_forces() is called)
     std::vector<motion> kinds_; ///< host copy of each particle's motion (it never changes)
     std::vector<std::pair<std::size_t, observer>> observers_;

@@ -67,20 +67,19 @@ struct particle_energy {
         e.kinetic = Real(0.5) * m * norm2(p.v_sync[i]);
         e.rotational = Real(0.2) * m * xi.w * xi.w * norm2(p.omega_sync[i]);
         e.potential = -m * dot(gravity, xi.xyz());
-        const unsigned listed = c.count[i] < c.capacity ? c.count[i] : static_cast<unsigned>(c.capacity);
-        for (unsigned k = 0; k < listed; ++k) {
-            const std::size_t entry = i * c.capacity + k;
-            const vec4<Real> xj = p.x[c.partner[entry]];
-            const Real delta_n = norm(box.nearest_image(xi.xyz() - xj.xyz())) - (xi.w + xj.w);
-            if (delta_n < Real(0)) e.elastic += Law::pair_energy(pair_params, delta_n, c.history[entry]) / 2;
-        }
-        for (int f = 0; f < wall_set<Real>::count; ++f) {
-            const wall_face<Real>& wall = walls.face[f];
-            if (!wall.active) continue;
-            const int a = f / 2;
-            const Real delta_n = (xi.xyz()[a] - Real(wall.position)) * wall_set<Real>::inward_normal(f)[a] - xi.w;
-            if (delta_n < Real(0))
-                e.elastic += Law::wall_energy(wall_params, delta_n, c.wall_history[i * wall_set<Real>::count + f]);
+        for (unsigned k = c.offset[i]; k < c.offset[i + 1]; ++k) {
+            const unsigned j = c.partner[k];
+            if (j < wall_partner_base) {
+                const vec4<Real> xj = p.x[j];
+                const Real delta_n = norm(box.nearest_image_inside(xi.xyz() - xj.xyz())) - (xi.w + xj.w);
+                if (delta_n < Real(0)) e.elastic += Law::pair_energy(pair_params, delta_n, c.history[k]) / 2;
+            } else {
+                const int f = static_cast<int>(j - wall_partner_base);
+                const int a = f / 2;
+                const Real delta_n =
+                    (xi.xyz()[a] - Real(walls.face[f].position)) * wall_set<Real>::inward_normal(f)[a] - xi.w;
+                if (delta_n < Real(0)) e.elastic += Law::wall_energy(wall_params, delta_n, c.history[k]);
+            }
         }
         e.dissipated_visc = p.e_visc[i];
         e.dissipated_fric = p.e_fric[i];

@@ -41,40 +41,41 @@ double wall_normal_stress(const simulation<Real, Policy, Law, Integrator>& sim, 
 /// Host copies of what the contact analyses need.
 template <class Real>
 struct contact_snapshot {
-    std::vector<vec4<Real>> x;        ///< centre (m) in xyz, radius (m) in w
-    std::vector<unsigned> counts;     ///< partners listed per particle (contact_lists layout)
-    std::vector<unsigned> partners;   ///< partner of entry k of particle i at [i * capacity + k]
-    std::vector<vec4<Real>> forces;   ///< per entry: tangential force on i (N) in xyz, f_n . n (N) in w
-    std::vector<vec3<Real>> wall_forces; ///< force of face f on particle i (N), [i * 6 + f]
-    std::size_t capacity = 0;         ///< entries per particle
-    world<Real> box;                  ///< the world (periodic axes for nearest images)
-    wall_set<Real> walls;             ///< the walls, with their positions
+    std::vector<vec4<Real>> x;   ///< centre (m) in xyz, radius (m) in w
+    contact_table<Real> table;   ///< the contact lists in user order, with each entry's force
+    world<Real> box;             ///< the world (periodic axes for nearest images)
+    wall_set<Real> walls;        ///< the walls, with their positions
 
     /// Number of particles.
     std::size_t size() const { return x.size(); }
-    /// Entries of particle i that are listed (count clamped to the capacity).
-    unsigned listed(std::size_t i) const { return counts[i] < capacity ? counts[i] : static_cast<unsigned>(capacity); }
     /// Whether entry e carries a force (a contact that touched in the last step).
     bool touching(std::size_t e) const
     {
-        const vec4<Real>& f = forces[e];
+        const vec4<Real>& f = table.force[e];
         return f.x != Real(0) || f.y != Real(0) || f.z != Real(0) || f.w != Real(0);
+    }
+    /// Whether a partner code names a wall face.
+    static bool is_wall(unsigned partner) { return partner >= wall_partner_base; }
+    /// The whole force (N) of wall entry e on its particle: friction plus normal.
+    vec3<Real> wall_force(std::size_t e) const
+    {
+        const vec4<Real>& f = table.force[e];
+        return f.xyz() + wall_set<Real>::inward_normal(int(table.partner[e] - wall_partner_base)) * f.w;
     }
 };
 
 /// Copies the particles, contact lists and walls of a simulation to the host. The forces are
 /// those of the last step, the positions those after it: the analyses below are exact for a
-/// static assembly.
+/// static assembly. Throws when the simulation records no contact forces
+/// (settings.contact_forces = false).
 template <class Real, class Policy, class Law, class Integrator>
 contact_snapshot<Real> take_contact_snapshot(const simulation<Real, Policy, Law, Integrator>& sim)
 {
+    if (!sim.config().contact_forces)
+        detail::fail("contact analyses need the contact forces: the simulation was set up with settings.contact_forces = false");
     contact_snapshot<Real> c;
     c.x = sim.snapshot().x;
-    c.counts = sim.contacts().counts();
-    c.partners = sim.contacts().partners();
-    c.forces = sim.contacts().forces();
-    c.wall_forces = sim.contacts().wall_forces();
-    c.capacity = sim.contacts().capacity();
+    c.table = sim.contacts();
     c.box = sim.config().box;
     c.walls = sim.walls();
     return c;
@@ -121,29 +122,28 @@ stress_tensor love_weber_stress(const contact_snapshot<Real>& c, double volume)
     stress_tensor t;
     for (std::size_t i = 0; i < c.size(); ++i) {
         const vec3<Real> xi = c.x[i].xyz();
-        for (unsigned k = 0; k < c.listed(i); ++k) {
-            const std::size_t e = i * c.capacity + k;
+        for (std::size_t e = c.table.begin(i); e < c.table.end(i); ++e) {
             if (!c.touching(e)) continue;
-            const vec3<Real> d = c.box.nearest_image(xi - c.x[c.partners[e]].xyz()); // x_i - x_j
+            if (c.is_wall(c.table.partner[e])) {
+                // branch vector from the centre to the wall plane, along the wall's axis
+                const int f = int(c.table.partner[e] - wall_partner_base), a = f / 2;
+                const vec3<Real> fw = c.wall_force(e);
+                const double l = double(c.walls.face[f].position) - double(xi[a]);
+                for (int b = 0; b < 3; ++b) t.s[b][a] -= double(fw[b]) * l;
+                continue;
+            }
+            const vec3<Real> d = c.box.nearest_image(xi - c.x[c.table.partner[e]].xyz()); // x_i - x_j
             const double dist = double(norm(d));
             if (!(dist > 0)) continue;
-            const vec3<Real> ft = c.forces[e].xyz();
+            const vec3<Real> ft = c.table.force[e].xyz();
             double f[3], l[3];
             for (int a = 0; a < 3; ++a) {
                 const double n = double(d[a]) / dist; // from j towards i
-                f[a] = double(ft[a]) + double(c.forces[e].w) * n;
+                f[a] = double(ft[a]) + double(c.table.force[e].w) * n;
                 l[a] = -double(d[a]); // x_j - x_i
             }
             for (int a = 0; a < 3; ++a)
                 for (int b = 0; b < 3; ++b) t.s[a][b] -= f[a] * l[b] / 2;
-        }
-        for (int f = 0; f < wall_set<Real>::count; ++f) {
-            if (!c.walls.face[f].active) continue;
-            const vec3<Real> fw = c.wall_forces[i * wall_set<Real>::count + f];
-            if (fw.x == Real(0) && fw.y == Real(0) && fw.z == Real(0)) continue;
-            const int a = f / 2;
-            const double l = double(c.walls.face[f].position) - double(xi[a]); // branch vector l e_a
-            for (int b = 0; b < 3; ++b) t.s[b][a] -= double(fw[b]) * l;
         }
     }
     for (int a = 0; a < 3; ++a)
@@ -173,11 +173,8 @@ std::vector<unsigned> contact_counts(const contact_snapshot<Real>& c, bool with_
 {
     std::vector<unsigned> z(c.size(), 0u);
     for (std::size_t i = 0; i < c.size(); ++i) {
-        for (unsigned k = 0; k < c.listed(i); ++k)
-            if (c.touching(i * c.capacity + k)) ++z[i];
-        if (with_walls)
-            for (int f = 0; f < wall_set<Real>::count; ++f)
-                if (c.walls.face[f].active && norm2(c.wall_forces[i * wall_set<Real>::count + f]) > Real(0)) ++z[i];
+        for (std::size_t e = c.table.begin(i); e < c.table.end(i); ++e)
+            if (c.touching(e) && (with_walls || !c.is_wall(c.table.partner[e]))) ++z[i];
     }
     return z;
 }
@@ -217,18 +214,17 @@ std::vector<contact_force> contact_network(const contact_snapshot<Real>& c)
 {
     std::vector<contact_force> out;
     for (std::size_t i = 0; i < c.size(); ++i)
-        for (unsigned k = 0; k < c.listed(i); ++k) {
-            const std::size_t e = i * c.capacity + k;
-            const std::size_t j = c.partners[e];
-            if (j <= i || !c.touching(e)) continue;
+        for (std::size_t e = c.table.begin(i); e < c.table.end(i); ++e) {
+            const std::size_t j = c.table.partner[e];
+            if (c.is_wall(c.table.partner[e]) || j <= i || !c.touching(e)) continue;
             contact_force p;
             p.i = i;
             p.j = j;
             p.x_i = vec_cast<double>(c.x[i].xyz());
             p.x_j = vec_cast<double>(c.x[j].xyz());
             p.branch = vec_cast<double>(c.box.nearest_image(c.x[j].xyz() - c.x[i].xyz()));
-            p.normal = double(c.forces[e].w);
-            p.tangential = {double(c.forces[e].x), double(c.forces[e].y), double(c.forces[e].z)};
+            p.normal = double(c.table.force[e].w);
+            p.tangential = {double(c.table.force[e].x), double(c.table.force[e].y), double(c.table.force[e].z)};
             out.push_back(p);
         }
     return out;

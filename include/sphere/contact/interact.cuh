@@ -1,15 +1,22 @@
 #pragma once
 /// \file
 /// The interaction kernel: each particle gathers the forces and torques of its listed
-/// partners and of the walls it touches, with no atomics, so results are deterministic.
-/// Each pair is evaluated from both sides; each side books half of the pair's dissipation.
-/// Dashpots see the velocities at the time of the positions (v_sync, omega_sync); tangential
-/// springs follow the displacement of the last step (v, omega times dt: the velocities that
-/// moved the positions).
+/// partners and walls, with no atomics, so results are deterministic. Each pair is evaluated
+/// from both sides; each side books half of the pair's dissipation. Dashpots see the
+/// velocities at the time of the positions (v_sync, omega_sync); tangential springs follow the
+/// displacement of the last step (v, omega times dt: the velocities that moved the positions).
+///
+/// Two compile-time switches drop work that nothing reads: `Book` (the per-particle pressure,
+/// dissipation rates and dissipated energies of the energy audit) and `Record` (each entry's
+/// force, for the stress and contact-network analyses). The simulation picks them from its
+/// settings. A third, `OneVelocity`, says that the dashpots' velocities are the ones that moved
+/// the positions (velocity Verlet): the step's displacement is then the contact velocity times
+/// dt, and v, omega are not read a second time.
 #include <cstddef>
 
 #include "../boundary/walls.cuh"
 #include "../boundary/world.cuh"
+#include "../core/constants.cuh"
 #include "../particles/state.cuh"
 #include "contact_lists.cuh"
 #include "params.cuh"
@@ -18,7 +25,20 @@
 namespace sphere {
 namespace detail {
 
-template <class Real, class Law>
+/// The particles' forces on the six wall faces, along each face's axis (N), summed in double.
+struct wall_loads {
+    double force[6];
+    SPHERE_HD wall_loads operator+(const wall_loads& b) const
+    {
+        wall_loads out;
+        for (int f = 0; f < 6; ++f) out.force[f] = force[f] + b.force[f];
+        return out;
+    }
+};
+
+/// Particle i's contacts: writes its force and torque (and what Book and Record ask for) and
+/// returns its share of the wall loads.
+template <class Real, class Law, bool Book, bool Record, bool OneVelocity>
 struct interact {
     particle_view<Real> p;
     contact_view<Real> c;
@@ -27,79 +47,97 @@ struct interact {
     contact_params<Real> pair_params;
     contact_params<Real> wall_params;
     Real dt;
+    bool update_history; ///< false for a force evaluation that must leave the contacts as they are
 
-    SPHERE_HD void operator()(std::size_t i) const
+    SPHERE_HD wall_loads operator()(std::size_t i) const
     {
+        wall_loads loads{{0, 0, 0, 0, 0, 0}};
         const vec4<Real> xi = p.x[i];
-        const vec3<Real> vi = p.v_sync[i];
-        const vec3<Real> wi = p.omega_sync[i];
+        const vec3<Real> vi = p.v_sync[i], wi = p.omega_sync[i];
+        // the last step's motion (unused with OneVelocity)
+        const vec3<Real> si = OneVelocity ? vec3<Real>{0, 0, 0} : p.v[i] * dt;
+        const vec3<Real> ti = OneVelocity ? vec3<Real>{0, 0, 0} : p.omega[i] * dt;
+        const Real mi = p.mass[i];
         vec3<Real> force{0, 0, 0}, torque{0, 0, 0};
         Real fn_sum = 0, visc = 0, fric = 0;
 
-        const unsigned listed = c.count[i] < c.capacity ? c.count[i] : static_cast<unsigned>(c.capacity);
-        for (unsigned k = 0; k < listed; ++k) {
-            const std::size_t e = i * c.capacity + k;
+        const unsigned end = c.offset[i + 1];
+        for (unsigned e = c.offset[i]; e < end; ++e) {
             const unsigned j = c.partner[e];
-            const vec4<Real> xj = p.x[j];
-            const vec3<Real> d = box.nearest_image(xi.xyz() - xj.xyz());
-            const Real dist = norm(d);
-            const Real delta_n = dist - (xi.w + xj.w);
             vec4<Real> h = c.history[e];
-            if (delta_n < Real(0) && dist > Real(0)) {
-                const vec3<Real> n = d / dist;
-                const Real arm_i = xi.w + delta_n / 2, arm_j = xj.w + delta_n / 2;
-                const contact_motion<Real> m{
-                    n, delta_n, vi - p.v_sync[j] + arm_i * cross(n, wi) + arm_j * cross(n, p.omega_sync[j]),
-                    (p.v[i] - p.v[j] + arm_i * cross(n, p.omega[i]) + arm_j * cross(n, p.omega[j])) * dt};
-                const contact_result<Real> r = Law::pair(pair_params, m, h, dt);
-                force += r.normal + r.tangential;
-                torque -= arm_i * cross(n, r.tangential);
-                fn_sum += r.fn;
-                visc += r.visc_rate / 2;
-                fric += r.fric_rate / 2;
-                c.force[e] = {r.tangential.x, r.tangential.y, r.tangential.z, dot(r.normal, n)};
+            contact_result<Real> r;
+            Real arm;
+            vec3<Real> n;
+            bool touching;
+            if (j < wall_partner_base) {
+                const vec4<Real> xj = p.x[j];
+                const vec3<Real> d = box.nearest_image_inside(xi.xyz() - xj.xyz());
+                const Real dist2 = norm2(d), reach = xi.w + xj.w;
+                touching = dist2 < reach * reach && dist2 > Real(0);
+                if (touching) {
+                    const Real dist = std::sqrt(dist2);
+                    const Real delta_n = dist - reach;
+                    n = d * (Real(1) / dist);
+                    arm = xi.w + delta_n / 2;
+                    const Real arm_j = xj.w + delta_n / 2;
+                    const Real mj = p.mass[j];
+                    contact_motion<Real> m;
+                    m.n = n;
+                    m.delta_n = delta_n;
+                    m.velocity = vi - p.v_sync[j] + arm * cross(n, wi) + arm_j * cross(n, p.omega_sync[j]);
+                    m.step = OneVelocity ? m.velocity * dt
+                                         : si - p.v[j] * dt + arm * cross(n, ti) + arm_j * cross(n, p.omega[j] * dt);
+                    m.m_eff = mi * mj / (mi + mj);
+                    r = Law::pair(pair_params, m, h, dt);
+                    r.visc_rate /= 2;
+                    r.fric_rate /= 2;
+                }
             } else {
-                h = vec4<Real>{0, 0, 0, 0}; // a contact that has ended forgets its history
-                c.force[e] = vec4<Real>{0, 0, 0, 0};
+                const int f = static_cast<int>(j - wall_partner_base);
+                const wall_face<Real>& wall = walls.face[f];
+                const int a = f / 2;
+                n = wall_set<Real>::inward_normal(f);
+                const Real dist = (xi.xyz()[a] - Real(wall.position)) * n[a];
+                const Real delta_n = dist - xi.w;
+                touching = delta_n < Real(0);
+                if (touching) {
+                    arm = dist;
+                    contact_motion<Real> m{n, delta_n, vi + dist * cross(n, wi), si + dist * cross(n, ti), mi};
+                    m.velocity[a] -= Real(wall.velocity);
+                    if (OneVelocity) m.step = m.velocity * dt;
+                    else m.step[a] -= Real(wall.velocity) * dt;
+                    r = Law::wall(wall_params, m, h, dt);
+                    loads.force[f] = -double(r.normal[a] + r.tangential[a]);
+                }
             }
-            c.history[e] = h;
-        }
-
-        for (int f = 0; f < wall_set<Real>::count; ++f) {
-            const wall_face<Real>& wall = walls.face[f];
-            if (!wall.active) continue;
-            const std::size_t e = i * wall_set<Real>::count + static_cast<std::size_t>(f);
-            const int a = f / 2;
-            const vec3<Real> n = wall_set<Real>::inward_normal(f);
-            const Real dist = (xi.xyz()[a] - Real(wall.position)) * n[a];
-            const Real delta_n = dist - xi.w;
-            vec4<Real> h = c.wall_history[e];
-            vec3<Real> on_particle{0, 0, 0};
-            if (delta_n < Real(0)) {
-                contact_motion<Real> m{n, delta_n, vi + dist * cross(n, wi), (p.v[i] + dist * cross(n, p.omega[i])) * dt};
-                m.velocity[a] -= Real(wall.velocity);
-                m.step[a] -= Real(wall.velocity) * dt;
-                const contact_result<Real> r = Law::wall(wall_params, m, h, dt);
+            if (touching) {
                 force += r.normal + r.tangential;
-                torque -= dist * cross(n, r.tangential);
-                fn_sum += r.fn;
-                visc += r.visc_rate;
-                fric += r.fric_rate;
-                on_particle = r.normal + r.tangential;
+                torque -= arm * cross(n, r.tangential);
+                if (Book) {
+                    fn_sum += r.fn;
+                    visc += r.visc_rate;
+                    fric += r.fric_rate;
+                }
+                if (Record) c.force[e] = {r.tangential.x, r.tangential.y, r.tangential.z, dot(r.normal, n)};
+                if (update_history) c.history[e] = h;
             } else {
-                h = vec4<Real>{0, 0, 0, 0};
+                if (Record) c.force[e] = vec4<Real>{0, 0, 0, 0};
+                // a contact that has ended forgets its history
+                if (update_history && (h.x != Real(0) || h.y != Real(0) || h.z != Real(0) || h.w != Real(0)))
+                    c.history[e] = vec4<Real>{0, 0, 0, 0};
             }
-            c.wall_history[e] = h;
-            c.wall_force[e] = on_particle;
         }
 
         p.force[i] = force;
         p.torque[i] = torque;
-        p.pressure[i] = fn_sum / (4 * pi<Real> * xi.w * xi.w);
-        p.p_visc[i] = visc;
-        p.p_fric[i] = fric;
-        p.e_visc[i] += visc * dt;
-        p.e_fric[i] += fric * dt;
+        if (Book && update_history) {
+            p.pressure[i] = fn_sum / (4 * pi<Real> * xi.w * xi.w);
+            p.p_visc[i] = visc;
+            p.p_fric[i] = fric;
+            p.e_visc[i] += visc * dt;
+            p.e_fric[i] += fric * dt;
+        }
+        return loads;
     }
 };
 

@@ -28,7 +28,7 @@ struct normal_force {
 };
 
 template <class Real>
-SPHERE_HD normal_force<Real> linear_normal(const contact_params<Real>& p, Real delta_n, Real ddelta_n)
+SPHERE_HDI normal_force<Real> linear_normal(const contact_params<Real>& p, Real delta_n, Real ddelta_n)
 {
     const Real elastic = -p.k_n * delta_n;
     Real f = elastic - p.gamma_n * ddelta_n;
@@ -57,7 +57,7 @@ struct linear {
 
     /// Evaluates a pair contact with motion m, history entry h and time step dt (s).
     template <class Real>
-    SPHERE_HD static contact_result<Real> pair(const contact_params<Real>& p, const contact_motion<Real>& m,
+    SPHERE_HDI static contact_result<Real> pair(const contact_params<Real>& p, const contact_motion<Real>& m,
                                                vec4<Real>& h, Real dt)
     {
         return evaluate<PairTangential>(p, m, h, dt);
@@ -65,7 +65,7 @@ struct linear {
 
     /// Evaluates a wall contact (the wall is the partner).
     template <class Real>
-    SPHERE_HD static contact_result<Real> wall(const contact_params<Real>& p, const contact_motion<Real>& m,
+    SPHERE_HDI static contact_result<Real> wall(const contact_params<Real>& p, const contact_motion<Real>& m,
                                                vec4<Real>& h, Real dt)
     {
         return evaluate<WallTangential>(p, m, h, dt);
@@ -73,23 +73,28 @@ struct linear {
 
     /// Elastic energy stored in a pair contact: k_n delta_n^2 / 2 plus the tangential spring (J).
     template <class Real>
-    SPHERE_HD static Real pair_energy(const contact_params<Real>& p, Real delta_n, const vec4<Real>& h)
+    SPHERE_HDI static Real pair_energy(const contact_params<Real>& p, Real delta_n, const vec4<Real>& h)
     {
         return Real(0.5) * p.k_n * delta_n * delta_n + PairTangential::stored_energy(p, h);
     }
 
     /// Elastic energy stored in a wall contact (J).
     template <class Real>
-    SPHERE_HD static Real wall_energy(const contact_params<Real>& p, Real delta_n, const vec4<Real>& h)
+    SPHERE_HDI static Real wall_energy(const contact_params<Real>& p, Real delta_n, const vec4<Real>& h)
     {
         return Real(0.5) * p.k_n * delta_n * delta_n + WallTangential::stored_energy(p, h);
     }
 
 private:
     template <class Tangential, class Real>
-    SPHERE_HD static contact_result<Real> evaluate(const contact_params<Real>& p, const contact_motion<Real>& m,
+    SPHERE_HDI static contact_result<Real> evaluate(const contact_params<Real>& given, const contact_motion<Real>& m,
                                                    vec4<Real>& h, Real dt)
     {
+        contact_params<Real> p = given;
+        if (p.damping == damping_convention::mass_scaled) { // gamma in 1/s: c = gamma m_eff (N s/m)
+            p.gamma_n *= m.m_eff;
+            p.gamma_t *= m.m_eff;
+        }
         const vec3<Real>& n = m.n;
         const Real ddelta_n = dot(m.velocity, n);
         const normal_force<Real> fn = linear_normal(p, m.delta_n, ddelta_n);
@@ -118,8 +123,11 @@ private:
         };
         positive(p.k_n, "k_n", "N/m");
         non_negative(p.k_t, "k_t", "N/m");
-        non_negative(p.gamma_n, "gamma_n", "N s/m");
-        non_negative(p.gamma_t, "gamma_t", "N s/m");
+        const bool scaled = p.damping == damping_convention::mass_scaled;
+        if (p.damping != damping_convention::absolute && !scaled)
+            detail::fail(where, ".damping = ", unsigned(p.damping), ": not a damping_convention");
+        non_negative(p.gamma_n, "gamma_n", scaled ? "1/s (mass-scaled)" : "N s/m");
+        non_negative(p.gamma_t, "gamma_t", scaled ? "1/s (mass-scaled)" : "N s/m");
         non_negative(p.mu_s, "mu_s", "(friction)");
         non_negative(p.mu_d, "mu_d", "(friction)");
         if (p.mu_d > p.mu_s)

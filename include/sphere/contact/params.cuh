@@ -1,8 +1,16 @@
 #pragma once
 /// \file
 /// Parameters of the linear contact model, for particle pairs and for walls.
+#include <cstdint>
 
 namespace sphere {
+
+/// How the dashpot coefficients gamma_n and gamma_t are given.
+enum class damping_convention : std::uint8_t {
+    absolute = 0,    ///< in N s/m, the same for every contact (sphere's convention)
+    mass_scaled = 1, ///< in 1/s, multiplied by the contact's effective mass m_eff (kg): the
+                     ///< convention of LAMMPS gran/hooke and LIGGGHTS (docs/physics.md, "Normal force")
+};
 
 /// Linear elastic-viscous contact parameters, SI units (docs/physics.md, "Contact model").
 /// For walls, gamma_n/gamma_t/mu_s/mu_d play the role of sphere's gamma_wn/gamma_wt/mu_ws/mu_wd.
@@ -10,11 +18,12 @@ template <class Real>
 struct contact_params {
     Real k_n = 0;      ///< normal stiffness (N/m), > 0
     Real k_t = 0;      ///< tangential stiffness (N/m), > 0 for elastic tangential laws
-    Real gamma_n = 0;  ///< normal viscosity (N s/m), absolute, >= 0
-    Real gamma_t = 0;  ///< tangential viscosity (N s/m), >= 0
+    Real gamma_n = 0;  ///< normal viscosity, >= 0: N s/m, or 1/s when mass-scaled
+    Real gamma_t = 0;  ///< tangential viscosity, >= 0: N s/m, or 1/s when mass-scaled
     Real mu_s = 0;     ///< static friction coefficient, >= 0
     Real mu_d = 0;     ///< dynamic friction coefficient, 0 <= mu_d <= mu_s
     bool tension = false; ///< allow an attractive normal force (false: clipped at 0, as sphere does)
+    damping_convention damping = damping_convention::absolute; ///< units of gamma_n and gamma_t
 };
 
 } // namespace sphere

@@ -14,6 +14,7 @@ struct contact_motion {
                          ///< at the time of the positions (m/s): drives the dashpots
     vec3<Real> step;     ///< displacement of the contact point relative to the partner's during
                          ///< the step that led to the positions (m): drives the tangential spring
+    Real m_eff;          ///< effective mass (kg): m_i m_j / (m_i + m_j) for a pair, m_i at a wall
 };
 
 /// One evaluated contact, as seen by the particle it acts on.

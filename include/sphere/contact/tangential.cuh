@@ -30,16 +30,17 @@ struct visco_frictional {
     static void validate(const contact_params<Real>&, const char*) {}
 
     template <class Real>
-    SPHERE_HD static tangential_force<Real> evaluate(const contact_params<Real>& p, const vec3<Real>& /*n*/,
+    SPHERE_HDI static tangential_force<Real> evaluate(const contact_params<Real>& p, const vec3<Real>& /*n*/,
                                                      const vec3<Real>& vt, const vec3<Real>& /*step_t*/, Real fn,
                                                      vec4<Real>& h, Real /*dt*/)
     {
         tangential_force<Real> out;
         out.force = -p.gamma_t * vt;
-        const Real ft = norm(out.force);
+        const Real ft2 = norm2(out.force);
         const bool was_sliding = h.w != Real(0);
         const Real limit = (was_sliding ? p.mu_d : p.mu_s) * fn;
-        if (ft > limit) {
+        if (ft2 > limit * limit) {
+            const Real ft = std::sqrt(ft2);
             const Real slide_limit = p.mu_d * fn;
             out.force = out.force * (slide_limit / ft);
             out.fric_rate = slide_limit * norm(vt);
@@ -52,7 +53,7 @@ struct visco_frictional {
     }
 
     template <class Real>
-    SPHERE_HD static Real stored_energy(const contact_params<Real>&, const vec4<Real>&) { return 0; }
+    SPHERE_HDI static Real stored_energy(const contact_params<Real>&, const vec4<Real>&) { return 0; }
 };
 
 /// f_t = -k_t delta_t - gamma_t v_t with the incremental tangential displacement delta_t
@@ -73,24 +74,28 @@ struct elastic_viscous_frictional {
     }
 
     template <class Real>
-    SPHERE_HD static tangential_force<Real> evaluate(const contact_params<Real>& p, const vec3<Real>& n,
+    SPHERE_HDI static tangential_force<Real> evaluate(const contact_params<Real>& p, const vec3<Real>& n,
                                                      const vec3<Real>& vt, const vec3<Real>& step_t, Real fn,
                                                      vec4<Real>& h, Real dt)
     {
         tangential_force<Real> out;
         // Carry the displacement into the current contact plane, keeping its length.
         vec3<Real> d{h.x, h.y, h.z};
-        const Real len = norm(d);
-        d -= n * dot(n, d);
-        const Real len_in_plane = norm(d);
-        const vec3<Real> before = len_in_plane > Real(0) ? d * (len / len_in_plane) : vec3<Real>{0, 0, 0};
+        vec3<Real> before{0, 0, 0};
+        const Real len2 = norm2(d);
+        if (len2 > Real(0)) { // a new contact has no displacement to carry
+            d -= n * dot(n, d);
+            const Real in_plane2 = norm2(d);
+            if (in_plane2 > Real(0)) before = d * std::sqrt(len2 / in_plane2);
+        }
         d = before + step_t; // the spring follows the contact point's actual motion
 
         out.force = -p.k_t * d - p.gamma_t * vt;
-        const Real ft = norm(out.force);
+        const Real ft2 = norm2(out.force);
         const bool was_sliding = h.w != Real(0);
         const Real limit = (was_sliding ? p.mu_d : p.mu_s) * fn;
-        if (ft > limit) {
+        if (ft2 > limit * limit) {
+            const Real ft = std::sqrt(ft2);
             const Real slide_limit = p.mu_d * fn;
             const vec3<Real> t_hat = out.force / ft;
             const vec3<Real> slid = -(slide_limit / p.k_t) * t_hat;
@@ -111,7 +116,7 @@ struct elastic_viscous_frictional {
 
     /// Elastic energy of the tangential spring, k_t |delta_t|^2 / 2 (J).
     template <class Real>
-    SPHERE_HD static Real stored_energy(const contact_params<Real>& p, const vec4<Real>& h)
+    SPHERE_HDI static Real stored_energy(const contact_params<Real>& p, const vec4<Real>& h)
     {
         return Real(0.5) * p.k_t * (h.x * h.x + h.y * h.y + h.z * h.z);
     }

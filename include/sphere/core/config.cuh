@@ -14,6 +14,17 @@
 #define SPHERE_CUDA_COMPILER 0
 #endif
 
+/// SPHERE_HDI: SPHERE_HD and always inlined, for the small vector operations and contact-law
+/// pieces of the inner loops (g++ -O2 otherwise leaves calls like cross() out of line: a
+/// third of the interaction kernel's time, docs/performance.md).
+#if defined(__CUDACC__)
+#define SPHERE_HDI __host__ __device__ __forceinline__
+#elif defined(__GNUC__)
+#define SPHERE_HDI __attribute__((always_inline)) inline
+#else
+#define SPHERE_HDI inline
+#endif
+
 #if defined(__CUDA_ARCH__)
 #define SPHERE_DEVICE_CODE 1
 #else

@@ -8,7 +8,7 @@
 namespace sphere {
 
 /// Every error the library reports: bad input at setup, a particle that leaves the world or
-/// becomes non-finite during a run, a contact list that overflows its capacity, a time step
+/// becomes non-finite during a run, contact lists beyond 2^32 - 1 entries, a time step
 /// above the stable bound. `what()` names the offending value and where it came from.
 class error : public std::runtime_error {
 public:

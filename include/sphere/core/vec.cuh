@@ -12,50 +12,50 @@ template <class Real>
 struct vec3 {
     Real x, y, z;
 
-    SPHERE_HD Real& operator[](int a) { return a == 0 ? x : (a == 1 ? y : z); }
-    SPHERE_HD Real operator[](int a) const { return a == 0 ? x : (a == 1 ? y : z); }
+    SPHERE_HDI Real& operator[](int a) { return a == 0 ? x : (a == 1 ? y : z); }
+    SPHERE_HDI Real operator[](int a) const { return a == 0 ? x : (a == 1 ? y : z); }
 
-    SPHERE_HD vec3& operator+=(const vec3& b) { x += b.x; y += b.y; z += b.z; return *this; }
-    SPHERE_HD vec3& operator-=(const vec3& b) { x -= b.x; y -= b.y; z -= b.z; return *this; }
-    SPHERE_HD vec3& operator*=(Real s) { x *= s; y *= s; z *= s; return *this; }
+    SPHERE_HDI vec3& operator+=(const vec3& b) { x += b.x; y += b.y; z += b.z; return *this; }
+    SPHERE_HDI vec3& operator-=(const vec3& b) { x -= b.x; y -= b.y; z -= b.z; return *this; }
+    SPHERE_HDI vec3& operator*=(Real s) { x *= s; y *= s; z *= s; return *this; }
 };
 
 /// Position and radius packed 4-wide (x, y, z, r) so that one aligned load reads both.
 template <class Real>
 struct alignas(4 * sizeof(Real)) vec4 {
     Real x, y, z, w;
-    SPHERE_HD vec3<Real> xyz() const { return {x, y, z}; }
+    SPHERE_HDI vec3<Real> xyz() const { return {x, y, z}; }
 };
 
-template <class Real> SPHERE_HD vec3<Real> operator+(vec3<Real> a, const vec3<Real>& b) { return a += b; }
-template <class Real> SPHERE_HD vec3<Real> operator-(vec3<Real> a, const vec3<Real>& b) { return a -= b; }
-template <class Real> SPHERE_HD vec3<Real> operator-(const vec3<Real>& a) { return {-a.x, -a.y, -a.z}; }
-template <class Real> SPHERE_HD vec3<Real> operator*(vec3<Real> a, Real s) { return a *= s; }
-template <class Real> SPHERE_HD vec3<Real> operator*(Real s, vec3<Real> a) { return a *= s; }
-template <class Real> SPHERE_HD vec3<Real> operator/(const vec3<Real>& a, Real s) { return {a.x / s, a.y / s, a.z / s}; }
-template <class Real> SPHERE_HD bool operator==(const vec3<Real>& a, const vec3<Real>& b)
+template <class Real> SPHERE_HDI vec3<Real> operator+(vec3<Real> a, const vec3<Real>& b) { return a += b; }
+template <class Real> SPHERE_HDI vec3<Real> operator-(vec3<Real> a, const vec3<Real>& b) { return a -= b; }
+template <class Real> SPHERE_HDI vec3<Real> operator-(const vec3<Real>& a) { return {-a.x, -a.y, -a.z}; }
+template <class Real> SPHERE_HDI vec3<Real> operator*(vec3<Real> a, Real s) { return a *= s; }
+template <class Real> SPHERE_HDI vec3<Real> operator*(Real s, vec3<Real> a) { return a *= s; }
+template <class Real> SPHERE_HDI vec3<Real> operator/(const vec3<Real>& a, Real s) { return {a.x / s, a.y / s, a.z / s}; }
+template <class Real> SPHERE_HDI bool operator==(const vec3<Real>& a, const vec3<Real>& b)
 {
     return a.x == b.x && a.y == b.y && a.z == b.z;
 }
 
-template <class Real> SPHERE_HD Real dot(const vec3<Real>& a, const vec3<Real>& b)
+template <class Real> SPHERE_HDI Real dot(const vec3<Real>& a, const vec3<Real>& b)
 {
     return a.x * b.x + a.y * b.y + a.z * b.z;
 }
-template <class Real> SPHERE_HD vec3<Real> cross(const vec3<Real>& a, const vec3<Real>& b)
+template <class Real> SPHERE_HDI vec3<Real> cross(const vec3<Real>& a, const vec3<Real>& b)
 {
     return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
 }
-template <class Real> SPHERE_HD Real norm2(const vec3<Real>& a) { return dot(a, a); }
-template <class Real> SPHERE_HD Real norm(const vec3<Real>& a) { return std::sqrt(dot(a, a)); }
+template <class Real> SPHERE_HDI Real norm2(const vec3<Real>& a) { return dot(a, a); }
+template <class Real> SPHERE_HDI Real norm(const vec3<Real>& a) { return std::sqrt(dot(a, a)); }
 
-template <class Real> SPHERE_HD bool isfinite(const vec3<Real>& a)
+template <class Real> SPHERE_HDI bool isfinite(const vec3<Real>& a)
 {
     return std::isfinite(a.x) && std::isfinite(a.y) && std::isfinite(a.z);
 }
 
 /// Converts between precisions (e.g. a double vector from user input to the simulation's Real).
-template <class To, class From> SPHERE_HD vec3<To> vec_cast(const vec3<From>& a)
+template <class To, class From> SPHERE_HDI vec3<To> vec_cast(const vec3<From>& a)
 {
     return {static_cast<To>(a.x), static_cast<To>(a.y), static_cast<To>(a.z)};
 }

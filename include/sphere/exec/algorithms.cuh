@@ -4,7 +4,7 @@
 /// `sort_by_key` (stable, so equal keys keep their order and results are deterministic) and
 /// `transform_reduce` over an index range.
 ///
-/// Host reductions sum fixed chunks of 4096 indices and then the chunk results in order,
+/// Host reductions sum fixed chunks of 512 indices and then the chunk results in order,
 /// so a floating-point sum is bit-identical for any number of OpenMP threads.
 #include <cstddef>
 #include <vector>
@@ -20,6 +20,7 @@
 #if SPHERE_CUDA_COMPILER
 #include <thrust/execution_policy.h>
 #include <thrust/iterator/counting_iterator.h>
+#include <thrust/scan.h>
 #include <thrust/transform_reduce.h>
 #endif
 
@@ -46,11 +47,24 @@ void sort_by_key(host, Key* keys, Value* values, std::size_t n)
     else thrust::stable_sort_by_key(thrust::cpp::par, keys, keys + n, values);
 }
 
+/// Replaces values[0, n) by their exclusive prefix sums (values[0] becomes 0); returns the
+/// total of the original values. For the offsets of compressed rows.
+inline std::size_t exclusive_scan_in_place(host, unsigned* values, std::size_t n)
+{
+    std::size_t sum = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+        const unsigned v = values[i];
+        values[i] = static_cast<unsigned>(sum);
+        sum += v;
+    }
+    return sum;
+}
+
 /// Returns init op f(0) op f(1) ... op f(n-1), in a fixed association order.
 template <class T, class Transform, class Op>
 T transform_reduce(host, std::size_t n, const Transform& f, T init, Op op)
 {
-    constexpr std::size_t chunk = 4096;
+    constexpr std::size_t chunk = 512; // small enough to share n = 1e4 evenly between threads
     const std::size_t chunks = (n + chunk - 1) / chunk;
     std::vector<T> partial(chunks, init);
     const long long count = static_cast<long long>(chunks);
@@ -72,6 +86,17 @@ template <class Key, class Value>
 void sort_by_key(cuda, Key* keys, Value* values, std::size_t n)
 {
     thrust::stable_sort_by_key(thrust::device, keys, keys + n, values);
+}
+
+inline std::size_t exclusive_scan_in_place(cuda, unsigned* values, std::size_t n)
+{
+    if (n == 0) return 0;
+    unsigned last = 0;
+    cudaMemcpy(&last, values + n - 1, sizeof last, cudaMemcpyDeviceToHost);
+    thrust::exclusive_scan(thrust::device, values, values + n, values);
+    unsigned before_last = 0;
+    cudaMemcpy(&before_last, values + n - 1, sizeof before_last, cudaMemcpyDeviceToHost);
+    return std::size_t(before_last) + last;
 }
 
 template <class T, class Transform, class Op>

@@ -92,19 +92,28 @@ struct fluid_reaction {
     }
 };
 
+/// Copies the position of the particle in slot k to its user index.
+template <class Real>
+struct positions_by_user {
+    particle_view<Real> p;
+    vec4<Real>* by_user;
+    SPHERE_HD void operator()(std::size_t k) const { by_user[p.user[k]] = p.x[k]; }
+};
+
 /// The work (J) the fluid force did on free particle i over a coupled step: the force, held
 /// constant, times the particle's displacement (nearest periodic image) since the step began.
+/// The start positions are kept by user index: the DEM steps may reorder the particles.
 template <class Real>
 struct fluid_work_on_particle {
     world<Real> box;
-    const vec4<Real>* before;
+    const vec4<Real>* before; ///< position at the step's start, by user index
     particle_view<Real> p;
     const vec3<Real>* force;
 
     SPHERE_HD double operator()(std::size_t i) const
     {
         if (static_cast<motion>(p.kind[i]) != motion::free) return 0;
-        const vec3<Real> d = box.nearest_image(p.x[i].xyz() - before[i].xyz());
+        const vec3<Real> d = box.nearest_image(p.x[i].xyz() - before[p.user[i]].xyz());
         return double(force[i].x) * double(d.x) + double(force[i].y) * double(d.y) + double(force[i].z) * double(d.z);
     }
 };
@@ -151,7 +160,7 @@ public:
                        detail::fluid_reaction<Real>{fluid_.view(), porosity_.bins(), forces});
         fluid_.step(dt);
         if (x_before_.size() != p.n) x_before_ = buffer<vec4<Real>, Policy>(p.n);
-        for_each_index(Policy{}, p.n, detail::copy_positions<Real>{p.x, x_before_.data()});
+        for_each_index(Policy{}, p.n, detail::positions_by_user<Real>{p, x_before_.data()});
         sim.run(options_.dem_steps);
         work_ += transform_reduce(
             Policy{}, p.n,
@@ -169,7 +178,7 @@ private:
     coupling_options options_;
     porosity_estimator<Real, Policy> porosity_;
     navier_stokes<Real, Policy, Poisson> fluid_;
-    buffer<vec4<Real>, Policy> x_before_;  ///< positions at the start of the DEM steps
+    buffer<vec4<Real>, Policy> x_before_;  ///< positions at the start of the DEM steps, by user index
     double work_ = 0;                      ///< work_on_particles() (J)
 };
 

@@ -5,6 +5,10 @@
 /// acceleration a, and says what the velocity is at the time of the new position (contact
 /// laws and diagnostics use that one). Errors at the default time step: docs/physics.md,
 /// "Integration".
+///
+/// An integrator with `drifts_before_forces` (velocity Verlet) splits the step around the
+/// force evaluation: `drift` before it (with the acceleration of the last forces), `advance`
+/// after it. The others do all of their step in `advance`, after the forces.
 #include "../core/vec.cuh"
 
 namespace sphere {
@@ -13,6 +17,7 @@ namespace integrate {
 /// Semi-implicit (symplectic) Euler: v += a dt; x += v dt. The default: it conserves the
 /// energy of an elastic collision (e = 1.000 +- 0.001 at dt = 0.075 sqrt(m / k_n)).
 struct semi_implicit_euler {
+    static constexpr bool drifts_before_forces = false;
     template <class Real>
     SPHERE_HD static void advance(vec3<Real>& x, vec3<Real>& v, const vec3<Real>& a, Real dt)
     {
@@ -32,6 +37,7 @@ struct semi_implicit_euler {
 /// sphere's second-order Taylor scheme: x += v dt + a dt^2 / 2; v += a dt. Creates energy in
 /// collisions (e = 1.087 for an elastic pair at the default time step).
 struct taylor2 {
+    static constexpr bool drifts_before_forces = false;
     template <class Real>
     SPHERE_HD static void advance(vec3<Real>& x, vec3<Real>& v, const vec3<Real>& a, Real dt)
     {
@@ -49,11 +55,40 @@ struct taylor2 {
 /// Explicit (forward) Euler: x += v dt; v += a dt. Creates energy (e = 1.181 for an elastic
 /// pair at the default time step).
 struct explicit_euler {
+    static constexpr bool drifts_before_forces = false;
     template <class Real>
     SPHERE_HD static void advance(vec3<Real>& x, vec3<Real>& v, const vec3<Real>& a, Real dt)
     {
         x += v * dt;
         v += a * dt;
+    }
+
+    template <class Real>
+    SPHERE_HD static vec3<Real> synchronous_velocity(const vec3<Real>& v, const vec3<Real>&, Real)
+    {
+        return v;
+    }
+};
+
+/// Velocity Verlet (LAMMPS' and LIGGGHTS' `fix nve/sphere`): a half kick with the last
+/// forces and a drift, v += a dt / 2; x += v dt (`drift`, before the forces); then the other
+/// half kick with the new forces, v += a dt / 2 (`advance`). The dashpots see the velocity
+/// between the two kicks, as in those codes; after the step v is the velocity at the time of
+/// the positions.
+struct velocity_verlet {
+    static constexpr bool drifts_before_forces = true;
+
+    template <class Real>
+    SPHERE_HD static void drift(vec3<Real>& x, vec3<Real>& v, const vec3<Real>& a, Real dt)
+    {
+        v += a * (dt / 2);
+        x += v * dt;
+    }
+
+    template <class Real>
+    SPHERE_HD static void advance(vec3<Real>&, vec3<Real>& v, const vec3<Real>& a, Real dt)
+    {
+        v += a * (dt / 2);
     }
 
     template <class Real>

@@ -43,7 +43,7 @@
 namespace sphere {
 
 /// The checkpoint format version this build writes, and the only one it reads.
-inline constexpr std::uint32_t checkpoint_format_version = 2;
+inline constexpr std::uint32_t checkpoint_format_version = 3;
 
 /// The first 8 bytes of every checkpoint.
 inline constexpr char checkpoint_magic[9] = "SPHERECK";
@@ -142,6 +142,7 @@ public:
         f64(double(p.mu_s));
         f64(double(p.mu_d));
         u32(p.tension ? 1u : 0u);
+        u32(static_cast<std::uint32_t>(p.damping));
     }
     /// An array: its element count (u64), then each element through `put`.
     template <class T, class Put>
@@ -225,6 +226,7 @@ public:
         p.mu_s = Real(f64(what));
         p.mu_d = Real(f64(what));
         p.tension = choice(what, 1) == 1;
+        p.damping = static_cast<damping_convention>(choice(what, 1));
         return p;
     }
     /// An array of `expected` elements of `element_bytes` bytes each, read by `get`.
@@ -265,7 +267,7 @@ std::string encode_checkpoint(const settings<Real>& config, Real dt, const simul
     const std::size_t n = s.particles.size();
     checkpoint_encoder e;
     e.bytes.reserve(detail::checkpoint_header_bytes + 1024 + n * (32 * 8 + 1 + 4 + 32 + 6 * 32) +
-                    s.partners.size() * (4 + 32) + detail::checkpoint_checksum_bytes);
+                    s.contacts.partner.size() * (4 + 32) + detail::checkpoint_checksum_bytes);
     e.bytes.append(checkpoint_magic, 8);
     e.u32(checkpoint_format_version);
     e.u32(static_cast<std::uint32_t>(sizeof(Real)));
@@ -280,7 +282,8 @@ std::string encode_checkpoint(const settings<Real>& config, Real dt, const simul
     e.v3(config.gravity);
     e.f64(double(dt));
     e.f64(double(config.skin));
-    e.u64(config.contact_capacity);
+    e.u32(config.contact_forces ? 1u : 0u);
+    e.u32(config.energy_audit ? 1u : 0u);
     e.f64(double(config.cell_size));
     for (const wall_control<Real>& c : config.walls) {
         e.u32(static_cast<std::uint32_t>(c.mode));
@@ -304,6 +307,7 @@ std::string encode_checkpoint(const settings<Real>& config, Real dt, const simul
         e.f64(double(w.force));
         e.f64(double(w.work));
     }
+    for (const wall_face<Real>& w : s.walls_at_build.face) e.f64(w.position);
     e.f64(s.drive_work);
     const auto put_v4 = [](checkpoint_encoder& out, const vec4<Real>& v) { out.v4(v); };
     const auto put_v3 = [](checkpoint_encoder& out, const vec3<Real>& v) { out.v3(v); };
@@ -316,11 +320,13 @@ std::string encode_checkpoint(const settings<Real>& config, Real dt, const simul
     for (const auto* field : {&p.mass, &p.pressure, &p.e_visc, &p.e_fric, &p.p_visc, &p.p_fric})
         e.array(*field, put_real);
     e.array(p.kind, [](checkpoint_encoder& out, std::uint8_t v) { out.u8(v); });
-    e.array(s.counts, put_u32);
-    e.array(s.partners, put_u32);
-    e.array(s.histories, put_v4);
-    e.array(s.wall_histories, put_v4);
+    std::vector<unsigned> counts(n);
+    for (std::size_t i = 0; i < n; ++i) counts[i] = static_cast<unsigned>(s.contacts.end(i) - s.contacts.begin(i));
+    e.array(counts, put_u32);
+    e.array(s.contacts.partner, put_u32);
+    e.array(s.contacts.history, put_v4);
     e.array(s.x_at_build, put_v4);
+    e.array(s.storage, put_u32);
 
     const std::uint64_t payload = e.bytes.size() - detail::checkpoint_header_bytes;
     for (int k = 0; k < 8; ++k) e.bytes[16 + k] = static_cast<char>((payload >> (8 * k)) & 0xffu);
@@ -386,10 +392,8 @@ checkpoint_data<Real> decode_checkpoint(const std::string& bytes, const std::str
     s.gravity = d.v3<Real>("settings.gravity");
     s.dt = Real(d.f64("the time step"));
     s.skin = Real(d.f64("settings.skin"));
-    const std::uint64_t capacity = d.u64("settings.contact_capacity");
-    if (capacity < 1 || capacity > std::numeric_limits<unsigned>::max())
-        d.inconsistent("settings.contact_capacity = ", capacity, " is out of range");
-    s.contact_capacity = static_cast<std::size_t>(capacity);
+    s.contact_forces = d.choice("settings.contact_forces", 1) == 1;
+    s.energy_audit = d.choice("settings.energy_audit", 1) == 1;
     s.cell_size = Real(d.f64("settings.cell_size"));
     for (wall_control<Real>& w : s.walls) {
         w.mode = static_cast<wall_mode>(d.choice("settings.walls[].mode", 2));
@@ -405,8 +409,6 @@ checkpoint_data<Real> decode_checkpoint(const std::string& bytes, const std::str
     const std::uint64_t n = d.u64("the particle count");
     if (n < 1 || n >= std::numeric_limits<unsigned>::max())
         d.inconsistent("the particle count ", n, " is out of range (1 to 2^32 - 2)");
-    if (capacity > std::numeric_limits<std::uint64_t>::max() / n)
-        d.inconsistent(n, " particles times a capacity of ", capacity, " overflows");
     st.steps = static_cast<std::size_t>(d.u64("the step count"));
     st.rebuilds = static_cast<std::size_t>(d.u64("the rebuild count"));
     st.needs_rebuild = d.choice("the rebuild flag", 1) == 1;
@@ -421,6 +423,10 @@ checkpoint_data<Real> decode_checkpoint(const std::string& bytes, const std::str
         if (w.active == s.box.periodic(f / 2))
             d.inconsistent("wall face ", f, " is ", w.active ? "active" : "inactive", " but axis ", f / 2, " is ",
                            s.box.periodic(f / 2) ? "periodic" : "closed by walls");
+    }
+    for (int f = 0; f < wall_set<Real>::count; ++f) {
+        st.walls_at_build.face[f] = st.walls.face[f];
+        st.walls_at_build.face[f].position = d.f64("a wall position at the last rebuild");
     }
     st.drive_work = d.f64("the drive work");
     const auto get_v4 = [](checkpoint_decoder& in) { return in.v4<Real>("a 4-vector"); };
@@ -444,20 +450,28 @@ checkpoint_data<Real> decode_checkpoint(const std::string& bytes, const std::str
         if (p.kind[i] > last_motion)
             d.inconsistent("particle ", i, " has motion kind ", unsigned(p.kind[i]), ", at most ", unsigned(last_motion),
                            " is valid");
-    st.counts = d.array<unsigned>("the contact counts", n, 4, get_u32);
-    st.partners = d.array<unsigned>("the contact partners", n * capacity, 4, get_u32);
-    st.histories = d.array<vec4<Real>>("the contact histories", n * capacity, 32, get_v4);
-    st.wall_histories = d.array<vec4<Real>>("the wall histories", n * wall_set<Real>::count, 32, get_v4);
+    const std::vector<unsigned> counts = d.array<unsigned>("the contact counts", n, 4, get_u32);
+    contact_table<Real>& t = st.contacts;
+    t.offset.assign(n + 1, 0);
+    for (std::size_t i = 0; i < n; ++i) t.offset[i + 1] = t.offset[i] + counts[i];
+    t.partner = d.array<unsigned>("the contact partners", t.offset[n], 4, get_u32);
+    t.history = d.array<vec4<Real>>("the contact histories", t.offset[n], 32, get_v4);
     st.x_at_build = d.array<vec4<Real>>("the positions at the last rebuild", n, 32, get_v4);
+    st.storage = d.array<unsigned>("the storage order", n, 4, get_u32);
     if (d.left() != 0) d.inconsistent(d.left(), " bytes follow the last array");
-    for (std::size_t i = 0; i < st.counts.size(); ++i) {
-        if (st.counts[i] > capacity)
-            d.inconsistent("particle ", i, " lists ", st.counts[i], " partners, more than the capacity ", capacity);
-        for (unsigned k = 0; k < st.counts[i]; ++k) {
-            const unsigned j = st.partners[i * capacity + k];
-            if (j >= n || j == i)
-                d.inconsistent("particle ", i, " lists partner ", j, " (", n, " particles)");
+    for (std::size_t i = 0; i < n; ++i)
+        for (std::size_t e = t.begin(i); e < t.end(i); ++e) {
+            const unsigned j = t.partner[e];
+            const bool wall = j >= wall_partner_base && j < wall_partner_base + unsigned(wall_set<Real>::count) &&
+                              st.walls.face[j - wall_partner_base].active;
+            if (!wall && (j >= n || j == i))
+                d.inconsistent("particle ", i, " lists partner ", j, " (", n, " particles, or an active wall face)");
         }
+    std::vector<char> seen(n, 0);
+    for (std::size_t k = 0; k < n; ++k) {
+        if (st.storage[k] >= n || seen[st.storage[k]])
+            d.inconsistent("the storage order is not a permutation: slot ", k, " holds particle ", st.storage[k]);
+        seen[st.storage[k]] = 1;
     }
     return c;
 }

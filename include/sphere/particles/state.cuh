@@ -1,8 +1,9 @@
 #pragma once
 /// \file
 /// Particle state as structure-of-arrays in a policy's memory, its kernel view, and a host
-/// snapshot of it. Particles keep the index the user gave them for the whole run: the
-/// neighbour grid sorts scratch copies, never this state.
+/// snapshot of it. The arrays are stored in an order of the library's choosing (the neighbour
+/// grid's cell order, set by `permute` at each rebuild); `user[k]` is the index the user gave
+/// the particle in storage slot k. Snapshots and restores speak in user indices.
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -10,6 +11,7 @@
 #include "../core/constants.cuh"
 #include "../core/vec.cuh"
 #include "../exec/buffer.cuh"
+#include "../exec/for_each.cuh"
 #include "particle.cuh"
 
 namespace sphere {
@@ -33,6 +35,7 @@ struct particle_view {
     Real* p_visc;           ///< rate of e_visc in the last step (W)
     Real* p_fric;           ///< rate of e_fric in the last step (W)
     std::uint8_t* kind;     ///< motion, as its underlying value
+    unsigned* user;         ///< the user's index of the particle in each storage slot
 };
 
 namespace detail {
@@ -43,6 +46,22 @@ struct copy_positions {
     const vec4<Real>* from;
     vec4<Real>* to;
     SPHERE_HD void operator()(std::size_t i) const { to[i] = from[i]; }
+};
+
+/// to[k] = from[order[k]] (kernel body of a permutation).
+template <class T>
+struct gather {
+    const T* from;
+    const unsigned* order;
+    T* to;
+    SPHERE_HD void operator()(std::size_t k) const { to[k] = from[order[k]]; }
+};
+
+template <class T>
+struct copy_back {
+    const T* from;
+    T* to;
+    SPHERE_HD void operator()(std::size_t k) const { to[k] = from[k]; }
 };
 } // namespace detail
 
@@ -94,6 +113,9 @@ public:
         }
         s.v_sync = s.v;
         s.omega_sync = s.omega;
+        std::vector<unsigned> identity(n);
+        for (std::size_t i = 0; i < n; ++i) identity[i] = static_cast<unsigned>(i);
+        user_.assign(identity);
         restore(s);
     }
 
@@ -104,43 +126,100 @@ public:
         return {x_.size(),       x_.data(),      v_.data(),      omega_.data(),  v_sync_.data(),
                 omega_sync_.data(),                                               angpos_.data(),
                 force_.data(),   torque_.data(), mass_.data(),   pressure_.data(), e_visc_.data(),
-                e_fric_.data(),  p_visc_.data(), p_fric_.data(), kind_.data()};
+                e_fric_.data(),  p_visc_.data(), p_fric_.data(), kind_.data(),   user_.data()};
     }
 
+    /// The user's index of the particle in each storage slot (host copy).
+    std::vector<unsigned> user_indices() const { return user_.to_host(); }
+
+    /// Moves the particle in slot order[k] to slot k, for every k (order is a permutation).
+    void permute(const unsigned* order)
+    {
+        const std::size_t n = size();
+        if (scratch_.size() != n) scratch_.resize(n);
+        each_field([&](auto& field) { permute_field(field, order); });
+        permute_field(user_, order);
+    }
+
+    /// Sets which particle each slot holds (user index per slot), e.g. for a restart; the
+    /// fields' contents must be restored afterwards.
+    void set_storage_order(const std::vector<unsigned>& user) { user_.assign(user); }
+
+    /// Applies the permutation of the last `permute` to another per-particle array that must
+    /// stay in step with the particles (e.g. external forces).
+    template <class T>
+    void permute_along(buffer<T, Policy>& field, const unsigned* order)
+    {
+        permute_field(field, order);
+    }
+
+    /// A host copy of every field, in user order.
     particle_snapshot<Real> snapshot() const
     {
-        return {x_.to_host(),      v_.to_host(),      omega_.to_host(),    v_sync_.to_host(),
-                omega_sync_.to_host(),                                       angpos_.to_host(),
-                force_.to_host(),  torque_.to_host(), mass_.to_host(),     pressure_.to_host(),
-                e_visc_.to_host(), e_fric_.to_host(), p_visc_.to_host(),   p_fric_.to_host(),
-                kind_.to_host()};
+        const std::vector<unsigned> user = user_.to_host();
+        auto out = [&](const auto& field) {
+            auto slots = field.to_host();
+            auto users = slots;
+            for (std::size_t k = 0; k < slots.size(); ++k) users[user[k]] = slots[k];
+            return users;
+        };
+        return {out(x_),     out(v_),      out(omega_),  out(v_sync_), out(omega_sync_),
+                out(angpos_), out(force_),  out(torque_), out(mass_),   out(pressure_),
+                out(e_visc_), out(e_fric_), out(p_visc_), out(p_fric_), out(kind_)};
     }
 
-    /// Replaces every field by a snapshot's (for restarts and for host-side edits).
+    /// Replaces every field by a snapshot's, given in user order (for restarts and for
+    /// host-side edits); the storage order stays.
     void restore(const particle_snapshot<Real>& s)
     {
-        x_.assign(s.x);
-        v_.assign(s.v);
-        omega_.assign(s.omega);
-        v_sync_.assign(s.v_sync);
-        omega_sync_.assign(s.omega_sync);
-        angpos_.assign(s.angpos);
-        force_.assign(s.force);
-        torque_.assign(s.torque);
-        mass_.assign(s.mass);
-        pressure_.assign(s.pressure);
-        e_visc_.assign(s.e_visc);
-        e_fric_.assign(s.e_fric);
-        p_visc_.assign(s.p_visc);
-        p_fric_.assign(s.p_fric);
-        kind_.assign(s.kind);
+        const std::vector<unsigned> user = user_.to_host();
+        auto in = [&](auto& field, const auto& users) {
+            auto slots = users;
+            for (std::size_t k = 0; k < slots.size(); ++k) slots[k] = users[user[k]];
+            field.assign(slots);
+        };
+        in(x_, s.x);
+        in(v_, s.v);
+        in(omega_, s.omega);
+        in(v_sync_, s.v_sync);
+        in(omega_sync_, s.omega_sync);
+        in(angpos_, s.angpos);
+        in(force_, s.force);
+        in(torque_, s.torque);
+        in(mass_, s.mass);
+        in(pressure_, s.pressure);
+        in(e_visc_, s.e_visc);
+        in(e_fric_, s.e_fric);
+        in(p_visc_, s.p_visc);
+        in(p_fric_, s.p_fric);
+        in(kind_, s.kind);
     }
 
 private:
+    template <class F>
+    void each_field(F f)
+    {
+        f(x_); f(v_); f(omega_); f(v_sync_); f(omega_sync_); f(angpos_); f(force_); f(torque_);
+        f(mass_); f(pressure_); f(e_visc_); f(e_fric_); f(p_visc_); f(p_fric_); f(kind_);
+    }
+
+    /// Gathers one field into the scratch (wide enough for any field) and copies it back.
+    template <class T>
+    void permute_field(buffer<T, Policy>& field, const unsigned* order)
+    {
+        static_assert(sizeof(T) <= sizeof(vec4<Real>) && alignof(T) <= alignof(vec4<Real>), "scratch too narrow");
+        T* tmp = reinterpret_cast<T*>(scratch_.data());
+        const std::size_t n = field.size();
+        for_each_index(Policy{}, n, detail::gather<T>{field.data(), order, tmp});
+        for_each_index(Policy{}, n, detail::copy_back<T>{tmp, field.data()});
+    }
+
     buffer<vec4<Real>, Policy> x_;
     buffer<vec3<Real>, Policy> v_, omega_, v_sync_, omega_sync_, angpos_, force_, torque_;
     buffer<Real, Policy> mass_, pressure_, e_visc_, e_fric_, p_visc_, p_fric_;
     buffer<std::uint8_t, Policy> kind_;
+    buffer<unsigned, Policy> user_;
+    buffer<vec4<Real>, Policy> scratch_; ///< permutation scratch, one element per particle
 };
 
 } // namespace sphere

@@ -1,0 +1,173 @@
+// bed: the dense-bed throughput benchmark of ../shared/bench/bed (README there): N polydisperse
+// spheres settled on a floor, periodic in x and y, ~5.7 persistent contacts each. Reads
+// bed_N.csv, runs 200 untimed steps, counts the contacts, times 2000 steps, counts again, and
+// prints the counts and particle-steps per second (docs/performance.md, "Dense bed").
+//
+//   build/bench/bed --csv bed_10000.csv [--precision double|float] [--threads 1] [--order file|shuffled]
+#include <sphere/dem.cuh>
+
+#include <CLI/CLI.hpp>
+
+#include <omp.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace {
+
+struct options {
+    std::string csv;
+    std::string precision = "double";
+    std::string order = "file"; // file | shuffled
+    int threads = 1;
+    bool audit = false;
+    std::size_t pre = 200, steps = 2000;
+};
+
+/// The scenario's constants (README section 2-4).
+constexpr double density = 2600, gravity = 9.81, k_n = 1e4, k_t = 1e4, mu = 0.4;
+constexpr double gamma_n = 18465.79868, gamma_t = 9232.89934;      // 1/s, times m_eff
+constexpr double gamma_n_wall = 13057.29147, gamma_t_wall = 6528.645733;
+constexpr double dt = 2.113274955e-6, skin = 4e-4;
+constexpr double mgd = 2.1367857e-7; // m_ref g d_ref (J)
+
+struct bed_file {
+    double length = 0, top = 0; ///< period L and the box height zhi (m)
+    std::vector<double> x, y, z, r;
+};
+
+bed_file read_bed(const std::string& path)
+{
+    std::ifstream in(path);
+    if (!in) throw std::runtime_error("cannot open " + path);
+    bed_file b;
+    std::string line;
+    std::getline(in, line);
+    if (line != "id,x,y,z,radius") throw std::runtime_error(path + ": header is not id,x,y,z,radius");
+    while (std::getline(in, line)) {
+        if (line.empty()) continue;
+        std::istringstream row(line);
+        std::string cell[5];
+        for (auto& c : cell) std::getline(row, c, ',');
+        b.x.push_back(std::stod(cell[1]));
+        b.y.push_back(std::stod(cell[2]));
+        b.z.push_back(std::stod(cell[3]));
+        b.r.push_back(std::stod(cell[4]));
+    }
+    // The README's boxes, chosen by N.
+    if (b.x.size() == 10000) { b.length = 0.0552; b.top = 0.034; }
+    else if (b.x.size() == 50000) { b.length = 0.0943; b.top = 0.050; }
+    else throw std::runtime_error(path + ": " + std::to_string(b.x.size()) + " particles; the scenario has 10000 or 50000");
+    return b;
+}
+
+struct counts {
+    double pair_contacts_per_particle;
+    std::size_t wall_contacts;
+    double kinetic; ///< KE_tr / (N m_ref g d_ref)
+};
+
+template <class Sim>
+counts count(const Sim& sim)
+{
+    using Real = typename Sim::real_type;
+    const auto s = sim.snapshot();
+    const auto& box = sim.config().box;
+    const std::size_t n = s.size();
+    std::size_t pairs = 0, walls = 0;
+    double ke = 0;
+    // Candidate partners: the contact lists hold every pair within r_i + r_j + skin.
+    const sphere::contact_table<Real> lists = sim.contacts();
+    for (std::size_t i = 0; i < n; ++i) {
+        for (unsigned j : lists.partners_of(i)) {
+            if (j <= i) continue;
+            const auto d = box.nearest_image(s.position(i) - s.position(j));
+            if (double(sphere::norm(d)) < double(s.radius(i)) + double(s.radius(j))) ++pairs;
+        }
+        if (double(s.x[i].z) < double(s.radius(i))) ++walls;
+        const sphere::vec3<double> v = sphere::vec_cast<double>(s.v_sync[i]);
+        ke += 0.5 * double(s.mass[i]) * sphere::dot(v, v);
+    }
+    return {2.0 * double(pairs) / double(n), walls, ke / (double(n) * mgd)};
+}
+
+template <class Real>
+int run(const options& o, const bed_file& b)
+{
+    using namespace sphere;
+    settings<Real> s;
+    s.box.lo = {0, 0, 0};
+    s.box.hi = {Real(b.length), Real(b.length), Real(b.top)};
+    s.box.axis[0] = s.box.axis[1] = boundary::periodic;
+    s.contact = {Real(k_n), Real(k_t), Real(gamma_n), Real(gamma_t), Real(mu), Real(mu), true};
+    s.contact.damping = damping_convention::mass_scaled;
+    s.wall = {Real(k_n), Real(k_t), Real(gamma_n_wall), Real(gamma_t_wall), Real(mu), Real(mu), true};
+    s.wall.damping = damping_convention::mass_scaled;
+    s.gravity = {0, 0, Real(-gravity)};
+    s.dt = Real(dt);
+    s.skin = Real(skin);
+    s.contact_forces = o.audit; // the scenario reads neither the contact forces nor the dissipation
+    s.energy_audit = o.audit;
+
+    std::vector<std::size_t> order(b.x.size());
+    for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+    if (o.order == "shuffled") std::shuffle(order.begin(), order.end(), std::mt19937(12345));
+    std::vector<particle<Real>> ps(order.size());
+    for (std::size_t k = 0; k < order.size(); ++k) {
+        const std::size_t i = order[k];
+        ps[k].position = {Real(b.x[i]), Real(b.y[i]), Real(b.z[i])};
+        ps[k].radius = Real(b.r[i]);
+        ps[k].density = Real(density);
+    }
+
+    using law = contact::linear<tangential::elastic_viscous_frictional, tangential::elastic_viscous_frictional>;
+    simulation<Real, host, law, integrate::velocity_verlet> sim(s, ps);
+    const std::size_t n = sim.size();
+    sim.run(o.pre);
+    const counts c0 = count(sim);
+    const std::size_t rebuilds0 = sim.rebuilds();
+    const auto t0 = std::chrono::steady_clock::now();
+    sim.run(o.steps);
+    const auto t1 = std::chrono::steady_clock::now();
+    const counts c1 = count(sim);
+    const double seconds = std::chrono::duration<double>(t1 - t0).count();
+    std::printf("sphere   N=%zu threads=%d precision=%s order=%s loop=%.3f s  %.3e particle-steps/s  contacts "
+                "%.4f -> %.4f  wall %zu -> %zu  KE/(N m g d) %.2e -> %.2e  rebuilds %zu\n",
+                n, o.threads, o.precision.c_str(), o.order.c_str(), seconds, double(n) * double(o.steps) / seconds,
+                c0.pair_contacts_per_particle, c1.pair_contacts_per_particle, c0.wall_contacts, c1.wall_contacts,
+                c0.kinetic, c1.kinetic, sim.rebuilds() - rebuilds0);
+    return 0;
+}
+
+} // namespace
+
+int main(int argc, char** argv)
+{
+    options o;
+    CLI::App app{"Dense-bed benchmark (../shared/bench/bed): counts and particle-steps per second"};
+    app.add_option("--csv", o.csv, "bed_N.csv (unpacked from ../shared/bench/bed/data)")->required();
+    app.add_option("--precision", o.precision, "double or float")->check(CLI::IsMember({"double", "float"}));
+    app.add_option("--threads", o.threads, "OpenMP threads")->check(CLI::Range(1, 256));
+    app.add_option("--order", o.order, "hand the particles over in the file's order or shuffled")
+        ->check(CLI::IsMember({"file", "shuffled"}));
+    app.add_flag("--audit", o.audit, "record the contact forces and book the energy audit (as the defaults do)");
+    app.add_option("--pre", o.pre, "untimed steps before the first count");
+    app.add_option("--steps", o.steps, "timed steps");
+    CLI11_PARSE(app, argc, argv);
+    try {
+        omp_set_num_threads(o.threads);
+        const bed_file b = read_bed(o.csv);
+        return o.precision == "float" ? run<float>(o, b) : run<double>(o, b);
+    } catch (const std::exception& e) {
+        std::cerr << "bed: " << e.what() << "\n";
+        return 1;
+    }
+}
