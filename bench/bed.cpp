@@ -3,7 +3,11 @@
 // bed_N.csv, runs 200 untimed steps, counts the contacts, times 2000 steps, counts again, and
 // prints the counts and particle-steps per second (docs/performance.md, "Dense bed").
 //
-//   build/bench/bed --csv bed_10000.csv [--precision double|float] [--threads 1] [--order file|shuffled]
+//   build/bench/bed --csv bed_10000.csv [--precision double|float|mixed] [--threads 1] [--order file|shuffled]
+//                   [--tile 4 5]   (the periodic bed repeated 4 x 5 times in x and y: 1e6 particles from 50k)
+//
+// Memory: the resident set (VmRSS, /proc/self/status) before the simulation is built, after the
+// timed steps, and its peak (VmHWM), per particle.
 #include <sphere/dem.cuh>
 
 #include <CLI/CLI.hpp>
@@ -30,7 +34,19 @@ struct options {
     int threads = 1;
     bool audit = false;
     std::size_t pre = 200, steps = 2000;
+    std::vector<unsigned> tile{1, 1}; ///< copies of the periodic bed along x and y
 };
+
+/// A field of /proc/self/status in bytes (VmRSS, VmHWM), 0 where there is none.
+double status_bytes(const char* field)
+{
+    std::ifstream in("/proc/self/status");
+    std::string line;
+    const std::string key = std::string(field) + ":";
+    while (std::getline(in, line))
+        if (line.compare(0, key.size(), key) == 0) return 1024.0 * std::stod(line.substr(key.size())); // kB
+    return 0;
+}
 
 /// The scenario's constants (README section 2-4).
 constexpr double density = 2600, gravity = 9.81, k_n = 1e4, k_t = 1e4, mu = 0.4;
@@ -99,13 +115,15 @@ counts count(const Sim& sim)
     return {2.0 * double(pairs) / double(n), walls, ke / (double(n) * mgd)};
 }
 
-template <class Real>
+template <class Precision>
 int run(const options& o, const bed_file& b)
 {
     using namespace sphere;
+    using Real = coord_t<Precision>; // the user-facing type: double for mixed
     settings<Real> s;
     s.box.lo = {0, 0, 0};
-    s.box.hi = {Real(b.length), Real(b.length), Real(b.top)};
+    const unsigned tx = o.tile[0], ty = o.tile[1];
+    s.box.hi = {Real(b.length * tx), Real(b.length * ty), Real(b.top)};
     s.box.axis[0] = s.box.axis[1] = boundary::periodic;
     s.contact = {Real(k_n), Real(k_t), Real(gamma_n), Real(gamma_t), Real(mu), Real(mu), true};
     s.contact.damping = damping_convention::mass_scaled;
@@ -117,21 +135,26 @@ int run(const options& o, const bed_file& b)
     s.contact_forces = o.audit; // the scenario reads neither the contact forces nor the dissipation
     s.energy_audit = o.audit;
 
-    std::vector<std::size_t> order(b.x.size());
+    const std::size_t per_tile = b.x.size();
+    std::vector<std::size_t> order(per_tile * tx * ty);
     for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
     if (o.order == "shuffled") std::shuffle(order.begin(), order.end(), std::mt19937(12345));
     std::vector<particle<Real>> ps(order.size());
     for (std::size_t k = 0; k < order.size(); ++k) {
-        const std::size_t i = order[k];
-        ps[k].position = {Real(b.x[i]), Real(b.y[i]), Real(b.z[i])};
+        const std::size_t i = order[k] % per_tile, t = order[k] / per_tile;
+        const double dx = double(t % tx) * b.length, dy = double(t / tx) * b.length;
+        ps[k].position = {Real(b.x[i] + dx), Real(b.y[i] + dy), Real(b.z[i])};
         ps[k].radius = Real(b.r[i]);
         ps[k].density = Real(density);
     }
+    const double rss_before = status_bytes("VmRSS");
 
     using law = contact::linear<tangential::elastic_viscous_frictional, tangential::elastic_viscous_frictional>;
-    simulation<Real, host, law, integrate::velocity_verlet> sim(s, ps);
+    simulation<Precision, host, law, integrate::velocity_verlet> sim(s, ps);
     const std::size_t n = sim.size();
     sim.run(o.pre);
+    // the simulation's own memory: measured before the counts make host copies
+    const double rss_sim = status_bytes("VmRSS"), peak_sim = status_bytes("VmHWM");
     const counts c0 = count(sim);
     const std::size_t rebuilds0 = sim.rebuilds();
     const auto t0 = std::chrono::steady_clock::now();
@@ -144,6 +167,10 @@ int run(const options& o, const bed_file& b)
                 n, o.threads, o.precision.c_str(), o.order.c_str(), seconds, double(n) * double(o.steps) / seconds,
                 c0.pair_contacts_per_particle, c1.pair_contacts_per_particle, c0.wall_contacts, c1.wall_contacts,
                 c0.kinetic, c1.kinetic, sim.rebuilds() - rebuilds0);
+    std::printf("memory   N=%zu precision=%s  RSS before the simulation %.0f MB; after %zu steps %.0f MB: +%.0f B/particle, "
+                "peak +%.0f B/particle (set-up included), %.0f B/particle for the whole process\n",
+                n, o.precision.c_str(), rss_before / 1e6, o.pre, rss_sim / 1e6, (rss_sim - rss_before) / double(n),
+                (peak_sim - rss_before) / double(n), peak_sim / double(n));
     return 0;
 }
 
@@ -154,18 +181,22 @@ int main(int argc, char** argv)
     options o;
     CLI::App app{"Dense-bed benchmark (../shared/bench/bed): counts and particle-steps per second"};
     app.add_option("--csv", o.csv, "bed_N.csv (unpacked from ../shared/bench/bed/data)")->required();
-    app.add_option("--precision", o.precision, "double or float")->check(CLI::IsMember({"double", "float"}));
+    app.add_option("--precision", o.precision, "double, float or mixed")->check(CLI::IsMember({"double", "float", "mixed"}));
     app.add_option("--threads", o.threads, "OpenMP threads")->check(CLI::Range(1, 256));
     app.add_option("--order", o.order, "hand the particles over in the file's order or shuffled")
         ->check(CLI::IsMember({"file", "shuffled"}));
     app.add_flag("--audit", o.audit, "record the contact forces and book the energy audit (as the defaults do)");
     app.add_option("--pre", o.pre, "untimed steps before the first count");
     app.add_option("--steps", o.steps, "timed steps");
+    app.add_option("--tile", o.tile, "copies of the periodic bed along x and y (e.g. 4 5: 1e6 particles from 50k)")
+        ->expected(2)
+        ->check(CLI::Range(1u, 100u));
     CLI11_PARSE(app, argc, argv);
     try {
         omp_set_num_threads(o.threads);
         const bed_file b = read_bed(o.csv);
-        return o.precision == "float" ? run<float>(o, b) : run<double>(o, b);
+        if (o.precision == "float") return run<float>(o, b);
+        return o.precision == "mixed" ? run<sphere::mixed>(o, b) : run<double>(o, b);
     } catch (const std::exception& e) {
         std::cerr << "bed: " << e.what() << "\n";
         return 1;

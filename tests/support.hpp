@@ -1,13 +1,23 @@
 #pragma once
 // Shared set-up for the validation tests: the common parameter set "P" of
 // ../shared/VALIDATION.md and small helpers. Every test is a TEMPLATE_TEST_CASE over float
-// and double; tolerances are stated where each test asserts.
+// and double (the validation cases D1-D11 also over sphere::mixed); tolerances are stated
+// where each test asserts.
 #include <sphere/dem.cuh>
 
 #include <cmath>
+#include <type_traits>
 #include <vector>
 
 namespace sphere_test {
+
+/// The type in which a simulation of precision P takes and hands out values (settings,
+/// particles, snapshots): P itself, or double for sphere::mixed.
+template <class P> using user_real = sphere::coord_t<P>;
+
+/// True when the particles' velocities, forces and contact histories are float (float and
+/// mixed): such tests use the float tolerances of ../shared/VALIDATION.md.
+template <class P> inline constexpr bool single_fields = std::is_same_v<sphere::real_t<P>, float>;
 
 /// Set P: R = 0.01 m, rho = 2500 kg/m^3, k_n = 1e5 N/m, no gravity.
 template <class Real>

@@ -25,8 +25,10 @@ using sphere_test::box_settings;
 using sphere_test::rel_err;
 using sphere_test::set_p;
 
-template <class Real, class Integrator = sphere::integrate::semi_implicit_euler>
-using host_sim = sphere::simulation<Real, sphere::host, sphere::contact::linear<>, Integrator>;
+template <class P, class Integrator = sphere::integrate::semi_implicit_euler>
+using host_sim = sphere::simulation<P, sphere::host, sphere::contact::linear<>, Integrator>;
+using sphere_test::single_fields;
+using sphere_test::user_real;
 
 constexpr double pi = 3.14159265358979323846;
 
@@ -148,11 +150,11 @@ struct head_on_result {
     vec3<double> p0, p1; ///< total momentum before and after (kg m/s)
 };
 
-template <class Real, class Integrator = sphere::integrate::semi_implicit_euler>
+template <class P, class Integrator = sphere::integrate::semi_implicit_euler, class Real = user_real<P>>
 head_on_result head_on(Real r_a, Real r_b, Real gap)
 {
     const sphere::settings<Real> s = box_settings<Real>();
-    host_sim<Real, Integrator> sim(s, {ball<Real>({-(r_a + gap / 2), 0, 0}, {1, 0, 0}, r_a),
+    host_sim<P, Integrator> sim(s, {ball<Real>({-(r_a + gap / 2), 0, 0}, {1, 0, 0}, r_a),
                                        ball<Real>({r_b + gap / 2, 0, 0}, {0, 0, 0}, r_b)});
     head_on_result out;
     out.dt = sim.dt();
@@ -176,7 +178,7 @@ struct damped_result {
     double elastic1; ///< elastic energy left after the collision (J)
 };
 
-template <class Real, class Integrator = sphere::integrate::semi_implicit_euler>
+template <class P, class Integrator = sphere::integrate::semi_implicit_euler, class Real = user_real<P>>
 damped_result damped_collision(bool wall, bool tension, Real dt, Real gap)
 {
     const Real r = set_p<Real>::radius;
@@ -192,8 +194,8 @@ damped_result damped_collision(bool wall, bool tension, Real dt, Real gap)
     } else {
         particles = {ball<Real>({-(r + gap / 2), 0, 0}, {1, 0, 0}), ball<Real>({r + gap / 2, 0, 0})};
     }
-    host_sim<Real, Integrator> sim(s, particles);
-    REQUIRE(sim.dt() == dt);
+    host_sim<P, Integrator> sim(s, particles);
+    REQUIRE(sim.dt() == Real(sphere::real_t<P>(dt))); // mixed: dt is rounded to float, the velocities' type
     damped_result out;
     out.ke0 = sim.energy().kinetic;
     const double z_wall = static_cast<double>(s.box.lo.z);
@@ -226,15 +228,15 @@ struct oblique_result {
     double slip1;                    ///< x-velocity of A's contact point relative to B's after (m/s)
 };
 
-template <class Real>
+template <class P, class Real = user_real<P>>
 oblique_result oblique_pair(vec3<Real> v_a, Real mu, Real dt)
 {
     const Real r = set_p<Real>::radius;
     sphere::settings<Real> s = box_settings<Real>();
     s.contact.mu_s = s.contact.mu_d = mu;
     s.dt = dt;
-    host_sim<Real> sim(s, {ball<Real>({0, 0, -r}, v_a), ball<Real>({0, 0, r})});
-    REQUIRE(sim.dt() == dt);
+    host_sim<P> sim(s, {ball<Real>({0, 0, -r}, v_a), ball<Real>({0, 0, r})});
+    REQUIRE(sim.dt() == Real(sphere::real_t<P>(dt))); // mixed: dt is rounded to float, the velocities' type
     oblique_result out;
     out.e0 = sim.energy().kinetic;
     out.c = watch_collision(sim, [](const auto& snap) { return pair_state(snap); }, k_n_p, 0, false, 100000);
@@ -262,8 +264,9 @@ oblique_result oblique_pair(vec3<Real> v_a, Real mu, Real dt)
 TEMPLATE_TEST_CASE("restitution helpers reproduce the D1/D2 reference values", "[collision][restitution]", float,
                    double)
 {
-    using Real = TestType;
-    const bool single = std::is_same<Real, float>::value;
+    using P = TestType;
+    using Real = user_real<P>;
+    const bool single = single_fields<P>;
     const Real m = set_p<Real>::mass(), k = set_p<Real>::k_n;
     const Real m_pair = sphere::effective_mass(m, m), m_wall = m;
     // effective_mass: m m / (m + m) = m / 2, to round-off.
@@ -338,18 +341,19 @@ TEMPLATE_TEST_CASE("restitution helpers reproduce the D1/D2 reference values", "
 // ---------------------------------------------------------------------------------------------
 // D1: elastic head-on collisions.
 // ---------------------------------------------------------------------------------------------
-TEMPLATE_TEST_CASE("D1: elastic head-on collisions", "[collision][D1]", float, double)
+TEMPLATE_TEST_CASE("D1: elastic head-on collisions", "[collision][D1]", float, double, sphere::mixed)
 {
-    using Real = TestType;
+    using P = TestType;
+    using Real = user_real<P>;
     // Momentum: each pair force is evaluated from both sides with n and v_c exactly negated, so
     // the forces cancel exactly; only the rounding of v += F/m dt remains: 1e-12 in double,
     // 1e-6 in float (VALIDATION D1).
-    const double momentum_tol = std::is_same<Real, float>::value ? 1e-6 : 1e-12;
+    const double momentum_tol = single_fields<P> ? 1e-6 : 1e-12;
 
     SECTION("equal radii: velocities exchange, t_c = 7.18868e-4 s, max overlap 2.28823e-4 m")
     {
         for (int j = 0; j < n_phases; ++j) {
-            const head_on_result r = head_on<Real>(Real(0.01), Real(0.01), Real(entry_gap(j, 1, dt_p)));
+            const head_on_result r = head_on<P>(Real(0.01), Real(0.01), Real(entry_gap(j, 1, dt_p)));
             INFO("phase " << j << ": dt = " << r.dt << " s, v_a = " << r.v_a << ", v_b = " << r.v_b
                           << " m/s, t_c = " << r.c.t_c << " s, max overlap = " << r.c.max_overlap
                           << " m, force steps = " << r.c.force_steps);
@@ -377,7 +381,7 @@ TEMPLATE_TEST_CASE("D1: elastic head-on collisions", "[collision][D1]", float, d
     SECTION("unequal radii 0.02 / 0.01, the larger moving: v1' = 7/9, v2' = 16/9 m/s, t_c = 9.58491e-4 s")
     {
         for (int j = 0; j < n_phases; ++j) {
-            const head_on_result r = head_on<Real>(Real(0.02), Real(0.01), Real(entry_gap(j, 1, dt_p)));
+            const head_on_result r = head_on<P>(Real(0.02), Real(0.01), Real(entry_gap(j, 1, dt_p)));
             INFO("phase " << j << ": dt = " << r.dt << " s, v_a = " << r.v_a << ", v_b = " << r.v_b
                           << " m/s, t_c = " << r.c.t_c << " s, force steps = " << r.c.force_steps);
             REQUIRE(r.c.separated);
@@ -397,24 +401,25 @@ TEMPLATE_TEST_CASE("D1: elastic head-on collisions", "[collision][D1]", float, d
 }
 
 TEMPLATE_TEST_CASE("D1: integrators at the default time step (pitfall 1)", "[collision][D1][integrators]", float,
-                   double)
+                   double, sphere::mixed)
 {
-    using Real = TestType;
+    using P = TestType;
+    using Real = user_real<P>;
     namespace integrate = sphere::integrate;
     // Elastic equal-radius pair at dt = 0.075 sqrt(m/k_n), every entry phase: e = v_b' - v_a'
     // (1 m/s incoming). References: VALIDATION pitfall 1.
     for (int j = 0; j < n_phases; ++j) {
         const Real gap = Real(entry_gap(j, 1, dt_p));
-        const head_on_result semi = head_on<Real, integrate::semi_implicit_euler>(Real(0.01), Real(0.01), gap);
-        const head_on_result taylor = head_on<Real, integrate::taylor2>(Real(0.01), Real(0.01), gap);
-        const head_on_result euler = head_on<Real, integrate::explicit_euler>(Real(0.01), Real(0.01), gap);
-        const head_on_result verlet = head_on<Real, integrate::velocity_verlet>(Real(0.01), Real(0.01), gap);
+        const head_on_result semi = head_on<P, integrate::semi_implicit_euler>(Real(0.01), Real(0.01), gap);
+        const head_on_result taylor = head_on<P, integrate::taylor2>(Real(0.01), Real(0.01), gap);
+        const head_on_result euler = head_on<P, integrate::explicit_euler>(Real(0.01), Real(0.01), gap);
+        const head_on_result verlet = head_on<P, integrate::velocity_verlet>(Real(0.01), Real(0.01), gap);
         INFO("phase " << j << ": e = " << semi.v_b - semi.v_a << " (semi-implicit Euler), " << taylor.v_b - taylor.v_a
                       << " (taylor2), " << euler.v_b - euler.v_a << " (explicit Euler), " << verlet.v_b - verlet.v_a
                       << " (velocity Verlet)");
         REQUIRE(verlet.c.separated);
         CHECK(rel_err(verlet.v_b - verlet.v_a, 1.0) < 3e-3); // velocity Verlet: 1 within 0.3%, as the default
-        CHECK(norm_d(verlet.p1 - verlet.p0) / norm_d(verlet.p0) < (std::is_same<Real, float>::value ? 1e-6 : 1e-12));
+        CHECK(norm_d(verlet.p1 - verlet.p0) / norm_d(verlet.p0) < (single_fields<P> ? 1e-6 : 1e-12));
         REQUIRE(semi.c.separated);
         REQUIRE(taylor.c.separated);
         REQUIRE(euler.c.separated);
@@ -445,9 +450,10 @@ const d2_reference d2_cases[] = {
 } // namespace
 
 namespace {
-template <class Real, class Integrator>
+template <class P, class Integrator>
 void check_d2()
 {
+    using Real = user_real<P>;
     // Tolerances (VALIDATION D2): 3% at the default dt, 0.5% at dt/10 (dt set explicitly).
     //
     // At the default dt, e depends on the entry phase: the dashpot switches on with a force
@@ -466,7 +472,7 @@ void check_d2()
             double e_mean = 0;
             for (int j = 0; j < n_phases; ++j) {
                 const damped_result r =
-                    damped_collision<Real, Integrator>(ref.wall, ref.tension, Real(dt), Real(entry_gap(j, 1, dt)));
+                    damped_collision<P, Integrator>(ref.wall, ref.tension, Real(dt), Real(entry_gap(j, 1, dt)));
                 INFO(ref.name << ", dt = " << dt << " s, phase " << j << ": e = " << r.e << " (" << ref.e
                               << "), t_c = " << r.c.t_c << " s (" << ref.t_c << "), force steps = "
                               << r.c.force_steps);
@@ -484,9 +490,10 @@ void check_d2()
     }
 }
 
-template <class Real, class Integrator>
+template <class P, class Integrator>
 void check_d3()
 {
+    using Real = user_real<P>;
     // KE0 = KE1 + E_visc, relative to KE0: no elastic energy is left once the bodies are apart,
     // and a head-on impact has no friction. Tolerances (VALIDATION D3): 2.5% at dt, 0.3% at
     // dt/10, at every entry phase.
@@ -495,7 +502,7 @@ void check_d3()
             const double dt = dt_p / refine, tol = refine == 1 ? 2.5e-2 : 3e-3;
             for (int j = 0; j < n_phases; ++j) {
                 const damped_result r =
-                    damped_collision<Real, Integrator>(ref.wall, ref.tension, Real(dt), Real(entry_gap(j, 1, dt)));
+                    damped_collision<P, Integrator>(ref.wall, ref.tension, Real(dt), Real(entry_gap(j, 1, dt)));
                 INFO(ref.name << ", dt = " << dt << " s, phase " << j << ": KE0 = " << r.ke0 << ", KE1 = " << r.ke1
                               << ", E_visc = " << r.e_visc << " J, (KE1 + E_visc) / KE0 = "
                               << (r.ke1 + r.e_visc) / r.ke0);
@@ -515,13 +522,13 @@ void check_d3()
 }
 } // namespace
 
-TEMPLATE_TEST_CASE("D2: damped restitution and contact duration", "[collision][D2]", float, double)
+TEMPLATE_TEST_CASE("D2: damped restitution and contact duration", "[collision][D2]", float, double, sphere::mixed)
 {
     SECTION("semi-implicit Euler (default)") { check_d2<TestType, sphere::integrate::semi_implicit_euler>(); }
     SECTION("velocity Verlet") { check_d2<TestType, sphere::integrate::velocity_verlet>(); }
 }
 
-TEMPLATE_TEST_CASE("D3: energy audit of the damped collisions", "[collision][D3]", float, double)
+TEMPLATE_TEST_CASE("D3: energy audit of the damped collisions", "[collision][D3]", float, double, sphere::mixed)
 {
     SECTION("semi-implicit Euler (default)") { check_d3<TestType, sphere::integrate::semi_implicit_euler>(); }
     SECTION("velocity Verlet") { check_d3<TestType, sphere::integrate::velocity_verlet>(); }
@@ -530,9 +537,10 @@ TEMPLATE_TEST_CASE("D3: energy audit of the damped collisions", "[collision][D3]
 // ---------------------------------------------------------------------------------------------
 // D4: oblique elastic pair without slip.
 // ---------------------------------------------------------------------------------------------
-TEMPLATE_TEST_CASE("D4: oblique elastic pair, no slip", "[collision][D4]", float, double)
+TEMPLATE_TEST_CASE("D4: oblique elastic pair, no slip", "[collision][D4]", float, double, sphere::mixed)
 {
-    using Real = TestType;
+    using P = TestType;
+    using Real = user_real<P>;
     // A at (0.01, 0, 0.01) m/s hits B at rest directly above it. Normal: the z-velocities
     // exchange. Tangential: with k_t = 2/7 k_n the tangential oscillation (effective mass 2/7 m*)
     // has the normal frequency, so the contact-point slip 0.01 m/s reverses exactly: impulse
@@ -542,8 +550,8 @@ TEMPLATE_TEST_CASE("D4: oblique elastic pair, no slip", "[collision][D4]", float
     // displacement accumulates increments v_t dt ~ 2e-8 m onto ~1e-6 m in single precision
     // over 300 steps).
     for (const int refine : {1, 10}) {
-        const double tol = refine == 1 ? 1e-2 : (std::is_same<Real, float>::value ? 5e-3 : 1e-3);
-        const oblique_result r = oblique_pair<Real>({Real(0.01), 0, Real(0.01)}, Real(1e9), Real(dt_p / refine));
+        const double tol = refine == 1 ? 1e-2 : (single_fields<P> ? 5e-3 : 1e-3);
+        const oblique_result r = oblique_pair<P>({Real(0.01), 0, Real(0.01)}, Real(1e9), Real(dt_p / refine));
         INFO("dt = " << dt_p / refine << " s: v_A = (" << r.v_a.x << ", " << r.v_a.z << "), v_B = (" << r.v_b.x
                      << ", " << r.v_b.z << ") m/s, omega_y = " << r.w_a.y << ", " << r.w_b.y
                      << " rad/s, slip after = " << r.slip1 << " m/s, (KE + rot) / KE0 = " << (r.ke1 + r.rot1) / r.e0);
@@ -568,9 +576,10 @@ TEMPLATE_TEST_CASE("D4: oblique elastic pair, no slip", "[collision][D4]", float
 // ---------------------------------------------------------------------------------------------
 // D5: oblique elastic pair in gross sliding.
 // ---------------------------------------------------------------------------------------------
-TEMPLATE_TEST_CASE("D5: oblique elastic pair, gross sliding", "[collision][D5]", float, double)
+TEMPLATE_TEST_CASE("D5: oblique elastic pair, gross sliding", "[collision][D5]", float, double, sphere::mixed)
 {
-    using Real = TestType;
+    using P = TestType;
+    using Real = user_real<P>;
     // A at (0.05, 0, 0.01) m/s onto B above it, mu = 0.3: normal impulse J_n = m 0.01 (elastic
     // exchange), tangential J_t = mu J_n = 0.003 m throughout -> v_Ax = 0.047, v_Bx = 0.003 m/s,
     // |omega_y| = (5/2) J_t / (m R) = 0.75 rad/s (negative on both). The slip 0.05 m/s drops by
@@ -587,7 +596,7 @@ TEMPLATE_TEST_CASE("D5: oblique elastic pair, gross sliding", "[collision][D5]",
         // shrink tenfold at a tenth of the speed, next section). So E_fric / E0 cannot meet 0.2%
         // of itself here: it is held to 0.5% of itself, the energy balance to 0.2% of E0, and
         // the 0.2% on E_fric is checked at a tenth of the speed.
-        const oblique_result r = oblique_pair<Real>({Real(0.05), 0, Real(0.01)}, mu, Real(dt_p));
+        const oblique_result r = oblique_pair<P>({Real(0.05), 0, Real(0.01)}, mu, Real(dt_p));
         INFO("v_A = (" << r.v_a.x << ", " << r.v_a.z << "), v_B = (" << r.v_b.x << ", " << r.v_b.z
                        << ") m/s, omega_y = " << r.w_a.y << ", " << r.w_b.y << " rad/s, slip after = " << r.slip1
                        << " m/s, E_fric / E0 = " << r.e_fric / r.e0 << ", balance = "
@@ -619,7 +628,7 @@ TEMPLATE_TEST_CASE("D5: oblique elastic pair, gross sliding", "[collision][D5]",
         // bookkeeping. Then E_fric / E0 = 0.09115 to 0.2% of itself, velocities to 0.2%.
         // Float: positions of ~0.01 m carry 1e-9 m against overlaps of 2.3e-7 m, 0.4% per ulp,
         // averaged over 300 steps; 0.2% still holds (measured 0.1%).
-        const oblique_result r = oblique_pair<Real>({Real(0.005), 0, Real(0.001)}, mu, Real(dt_p / 10));
+        const oblique_result r = oblique_pair<P>({Real(0.005), 0, Real(0.001)}, mu, Real(dt_p / 10));
         INFO("v_A = (" << r.v_a.x << ", " << r.v_a.z << "), v_B = (" << r.v_b.x << ", " << r.v_b.z
                        << ") m/s, omega_y = " << r.w_a.y << ", " << r.w_b.y << " rad/s, slip after = " << r.slip1
                        << " m/s, E_fric / E0 = " << r.e_fric / r.e0 << ", balance = "
@@ -638,9 +647,10 @@ TEMPLATE_TEST_CASE("D5: oblique elastic pair, gross sliding", "[collision][D5]",
 // ---------------------------------------------------------------------------------------------
 // D6: oblique impact on a wall in sliding.
 // ---------------------------------------------------------------------------------------------
-TEMPLATE_TEST_CASE("D6: oblique impact on a wall, sliding", "[collision][D6]", float, double)
+TEMPLATE_TEST_CASE("D6: oblique impact on a wall, sliding", "[collision][D6]", float, double, sphere::mixed)
 {
-    using Real = TestType;
+    using P = TestType;
+    using Real = user_real<P>;
     // A sphere at (0.05, 0, -0.01) m/s onto the floor z = lo, touching it; wall law
     // visco-frictional with gamma_wt = 100 N s/m (|gamma_wt v_t| = 5 N always exceeds
     // mu_w f_n <= 0.3 * 0.32 N, so it slides the whole contact), mu_w = 0.3, gamma_wn = 0.
@@ -657,7 +667,7 @@ TEMPLATE_TEST_CASE("D6: oblique impact on a wall, sliding", "[collision][D6]", f
         s.wall.gamma_t = Real(100);
         s.wall.mu_s = s.wall.mu_d = Real(0.3);
         s.dt = Real(dt_p / refine);
-        host_sim<Real> sim(s, {ball<Real>({0, 0, 0}, {Real(0.05), 0, Real(-0.01)})});
+        host_sim<P> sim(s, {ball<Real>({0, 0, 0}, {Real(0.05), 0, Real(-0.01)})});
         const double e0 = sim.energy().kinetic;
         const double z_wall = static_cast<double>(s.box.lo.z);
         const contact_record c = watch_collision(
@@ -689,9 +699,10 @@ TEMPLATE_TEST_CASE("D6: oblique impact on a wall, sliding", "[collision][D6]", f
 // Mass-scaled damping (damping_convention::mass_scaled): c = gamma m* per contact.
 // ---------------------------------------------------------------------------------------------
 TEMPLATE_TEST_CASE("mass-scaled damping: each pair gets c = gamma m*, so its restitution follows its masses",
-                   "[collision][damping]", float, double)
+                   "[collision][damping]", float, double, sphere::mixed)
 {
-    using Real = TestType;
+    using P = TestType;
+    using Real = user_real<P>;
     // Head-on pairs of radii (r_a, r_b) at 1 m/s with tension allowed, at dt/10: with
     // gamma = 1883.0 1/s every pair gets c_n = gamma m*, damping ratio zeta = gamma sqrt(m*) /
     // (2 sqrt(k_n)), restitution exp(-pi zeta / sqrt(1 - zeta^2)): 0.5 for the set-P pair (m* = m/2),
@@ -711,7 +722,7 @@ TEMPLATE_TEST_CASE("mass-scaled damping: each pair gets c = gamma m*, so its res
         s.contact.tension = true;
         s.dt = Real(dt_p / 10);
         const Real gap = Real(1e-4);
-        host_sim<Real> sim(s, {ball<Real>({-(Real(pc.r_a) + gap / 2), 0, 0}, {1, 0, 0}, Real(pc.r_a)),
+        host_sim<P> sim(s, {ball<Real>({-(Real(pc.r_a) + gap / 2), 0, 0}, {1, 0, 0}, Real(pc.r_a)),
                                ball<Real>({Real(pc.r_b) + gap / 2, 0, 0}, {0, 0, 0}, Real(pc.r_b))});
         const contact_record c =
             watch_collision(sim, [](const auto& snap) { return pair_state(snap); }, k_n_p, gamma * m_eff, true, 200000);
@@ -725,6 +736,6 @@ TEMPLATE_TEST_CASE("mass-scaled damping: each pair gets c = gamma m*, so its res
     sphere::settings<Real> s = box_settings<Real>();
     s.contact.damping = sphere::damping_convention::mass_scaled;
     s.contact.gamma_n = Real(-1);
-    REQUIRE_THROWS_WITH((host_sim<Real>(s, {ball<Real>({0, 0, 0})})),
+    REQUIRE_THROWS_WITH((host_sim<P>(s, {ball<Real>({0, 0, 0})})),
                         Catch::Contains("settings.contact.gamma_n = -1 1/s (mass-scaled): must be non-negative"));
 }

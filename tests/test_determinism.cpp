@@ -112,13 +112,13 @@ record<typename Sim::real_type> record_of(const Sim& sim)
 
 /// Runs `steps` steps of a set-up on `threads` OpenMP threads and records the result (with
 /// the diagnostics evaluated on the same thread count).
-template <class Real>
+template <class P, class Real = sphere_test::user_real<P>>
 record<Real> run_on_threads(const std::pair<sphere::settings<Real>, std::vector<sphere::particle<Real>>>& setup,
                             std::size_t steps, int threads)
 {
     omp_set_num_threads(threads);
     REQUIRE(threads_in_parallel_region() == threads);
-    sphere::simulation<Real> sim(setup.first, setup.second);
+    sphere::simulation<P> sim(setup.first, setup.second);
     sim.run(steps);
     return record_of(sim);
 }
@@ -174,21 +174,22 @@ void require_eventful(const record<Real>& r)
 
 } // namespace
 
-TEMPLATE_TEST_CASE("two runs of the same input give bit-identical states", "[determinism]", float, double)
+TEMPLATE_TEST_CASE("two runs of the same input give bit-identical states", "[determinism]", float, double, sphere::mixed)
 {
-    using Real = TestType;
+    using P = TestType;
+    using Real = sphere_test::user_real<P>;
     const std::size_t steps = 300;
     Real skin = 0;
     SECTION("skin 0") { skin = 0; }
     SECTION("skin 0.2 r0") { skin = Real(0.002); }
     const auto setup = assembly<Real>(7, skin, 99); // 343 particles
 
-    sphere::simulation<Real> first(setup.first, setup.second);
+    sphere::simulation<P> first(setup.first, setup.second);
     first.run(steps / 2);
     const auto halfway = first.snapshot();
     first.run(steps - steps / 2);
 
-    sphere::simulation<Real> second(setup.first, setup.second);
+    sphere::simulation<P> second(setup.first, setup.second);
     second.run(steps / 2);
     const auto halfway2 = second.snapshot();
     second.run(steps - steps / 2);
@@ -202,9 +203,10 @@ TEMPLATE_TEST_CASE("two runs of the same input give bit-identical states", "[det
     CHECK(diff.empty());
 }
 
-TEMPLATE_TEST_CASE("1 and 2 OpenMP threads give bit-identical states", "[determinism][openmp]", float, double)
+TEMPLATE_TEST_CASE("1 and 2 OpenMP threads give bit-identical states", "[determinism][openmp]", float, double, sphere::mixed)
 {
-    using Real = TestType;
+    using P = TestType;
+    using Real = sphere_test::user_real<P>;
     thread_count_guard guard;
     // The host backend runs loops and sorts of fewer than sphere::host_parallel_threshold
     // (2048) indices on the calling thread, and splits reductions into chunks of 4096: the
@@ -219,8 +221,8 @@ TEMPLATE_TEST_CASE("1 and 2 OpenMP threads give bit-identical states", "[determi
         SECTION("skin 0.2 r0") { skin = Real(0.002); }
         const auto setup = assembly<Real>(14, skin, 5);
 
-        const auto with_one = run_on_threads(setup, steps, 1);
-        const auto with_two = run_on_threads(setup, steps, 2);
+        const auto with_one = run_on_threads<P>(setup, steps, 1);
+        const auto with_two = run_on_threads<P>(setup, steps, 2);
 
         require_eventful(with_one);
         if (skin > 0) CHECK(with_one.rebuilds < steps);
@@ -233,8 +235,8 @@ TEMPLATE_TEST_CASE("1 and 2 OpenMP threads give bit-identical states", "[determi
         const std::size_t steps = 30;
         const auto setup = assembly<Real>(21, Real(0.002), 6);
 
-        const auto with_one = run_on_threads(setup, steps, 1);
-        const auto with_two = run_on_threads(setup, steps, 2);
+        const auto with_one = run_on_threads<P>(setup, steps, 1);
+        const auto with_two = run_on_threads<P>(setup, steps, 2);
 
         const std::vector<std::string> diff = differences(with_one, with_two);
         INFO("fields that differ: " << Catch::Detail::stringify(diff));
@@ -244,9 +246,10 @@ TEMPLATE_TEST_CASE("1 and 2 OpenMP threads give bit-identical states", "[determi
 }
 
 TEMPLATE_TEST_CASE("the storage order does not change the physics: reordering on and off agree bit for bit",
-                   "[determinism][reorder]", float, double)
+                   "[determinism][reorder]", float, double, sphere::mixed)
 {
-    using Real = TestType;
+    using P = TestType;
+    using Real = sphere_test::user_real<P>;
     // The particles are stored in the grid's cell order (settings.reorder, the default) or in
     // the user's order. Each particle sums its contacts in the order of its partners' user
     // indices either way, so every per-particle result is the same bits; only sums over all
@@ -255,7 +258,7 @@ TEMPLATE_TEST_CASE("the storage order does not change the physics: reordering on
     const auto setup = assembly<Real>(9, Real(0.002), 17); // 729 particles, skin 0.2 r0
     auto compare = [&](auto integrator) {
         using Integrator = decltype(integrator);
-        using sim_type = sphere::simulation<Real, sphere::host, sphere::contact::linear<>, Integrator>;
+        using sim_type = sphere::simulation<P, sphere::host, sphere::contact::linear<>, Integrator>;
         sphere::settings<Real> kept = setup.first;
         kept.reorder = false;
         sim_type sorted(setup.first, setup.second), unsorted(kept, setup.second);
@@ -283,11 +286,12 @@ TEMPLATE_TEST_CASE("the storage order does not change the physics: reordering on
 }
 
 TEMPLATE_TEST_CASE("run-time errors name the user's particle index, not its storage slot", "[determinism][reorder]",
-                   float, double)
+                   float, double, sphere::mixed)
 {
-    using Real = TestType;
+    using P = TestType;
+    using Real = sphere_test::user_real<P>;
     const auto setup = assembly<Real>(7, Real(0.002), 23);
-    sphere::simulation<Real> sim(setup.first, setup.second);
+    sphere::simulation<P> sim(setup.first, setup.second);
     sim.run(20);
     const std::vector<unsigned> storage = sim.state().storage;
     // A free particle whose slot is not its user index.

@@ -124,10 +124,11 @@ struct gas_run {
 
 /// Runs the gas for `duration` seconds at dt_factor times the default step, sampling the energy
 /// and momentum `samples` times; counts collisions when asked (one snapshot per step).
-template <class Real, class Integrator>
+template <class P, class Integrator>
 gas_run run_gas(double dt_factor, double duration, std::size_t samples, bool count_collisions)
 {
-    sphere::simulation<Real, sphere::host, sphere::contact::linear<>, Integrator> sim(gas_settings<Real>(dt_factor), gas_particles<Real>(20240611u));
+    using Real = sphere_test::user_real<P>;
+    sphere::simulation<P, sphere::host, sphere::contact::linear<>, Integrator> sim(gas_settings<Real>(dt_factor), gas_particles<Real>(20240611u));
     gas_run r;
     const auto first = sim.snapshot();
     double sum_mv = 0;
@@ -173,15 +174,15 @@ gas_run run_gas(double dt_factor, double duration, std::size_t samples, bool cou
 } // namespace
 
 namespace {
-template <class Real, class Integrator>
+template <class P, class Integrator>
 void check_d11()
 {
     // Simulated time: 0.05 s. Kinetic theory: mean free path 1 / (sqrt 2 n pi d^2) = 0.047 m at
     // n = 1000 / 0.43756^3, mean speed sqrt(8 / pi) = 1.6 m/s, so ~34 collisions per particle
     // per second, ~850 pair collisions in all (plus the wall hits) in 0.05 s; ~950 are counted.
     const double duration = 0.05;
-    const gas_run coarse = run_gas<Real, Integrator>(1.0, duration, 200, true);
-    const gas_run fine = run_gas<Real, Integrator>(0.1, duration, 200, false);
+    const gas_run coarse = run_gas<P, Integrator>(1.0, duration, 200, true);
+    const gas_run fine = run_gas<P, Integrator>(0.1, duration, 200, false);
     INFO(std::setprecision(8) << "dt: " << coarse.steps << " steps (" << coarse.rebuilds << " list rebuilds), ~"
                               << coarse.collisions << " collisions, E0 = " << coarse.e0 << " J, energy drift "
                               << coarse.energy_drift << ", momentum drift " << coarse.momentum_drift);
@@ -193,7 +194,7 @@ void check_d11()
     // Momentum in x and y (periodic, no walls): conserved to round-off. Pair forces are exact
     // negatives of each other; what remains is the rounding of v += f / m dt and of the sums:
     // 1e-10 of sum m |v| in double, 1e-4 in float (VALIDATION D11).
-    const double p_tol = std::is_same<Real, float>::value ? 1e-4 : 1e-10;
+    const double p_tol = sphere_test::single_fields<P> ? 1e-4 : 1e-10;
     CHECK(coarse.momentum_drift < p_tol);
     CHECK(fine.momentum_drift < p_tol);
 
@@ -213,7 +214,7 @@ void check_d11()
 }
 } // namespace
 
-TEMPLATE_TEST_CASE("D11 elastic gas conserves momentum and energy", "[gas][D11]", float, double)
+TEMPLATE_TEST_CASE("D11 elastic gas conserves momentum and energy", "[gas][D11]", float, double, sphere::mixed)
 {
     SECTION("semi-implicit Euler (default)") { check_d11<TestType, sphere::integrate::semi_implicit_euler>(); }
     SECTION("velocity Verlet") { check_d11<TestType, sphere::integrate::velocity_verlet>(); }

@@ -152,14 +152,15 @@ std::vector<sphere::particle<Real>> eventful_particles()
     return ps;
 }
 
-template <class Real>
-using host_sim = sphere::simulation<Real>;
+template <class P>
+using host_sim = sphere::simulation<P>;
 
 /// A state with every field set: eventful_settings/particles after `steps` steps.
-template <class Real>
-host_sim<Real> eventful_run(std::size_t steps)
+template <class P>
+host_sim<P> eventful_run(std::size_t steps)
 {
-    host_sim<Real> sim(eventful_settings<Real>(), eventful_particles<Real>());
+    using Real = sphere_test::user_real<P>;
+    host_sim<P> sim(eventful_settings<Real>(), eventful_particles<Real>());
     sim.run(steps);
     return sim;
 }
@@ -178,20 +179,23 @@ std::string replace_once(std::string text, const std::string& from, const std::s
 // (a) restart
 // ---------------------------------------------------------------------------------------------
 
-TEMPLATE_TEST_CASE("checkpoint restart continues bit-identically", "[io][checkpoint]", float, double)
+TEMPLATE_TEST_CASE("checkpoint restart continues bit-identically", "[io][checkpoint]", float, double, sphere::mixed)
 {
-    using Real = TestType;
+    // A mixed simulation's checkpoint holds its user-facing values (double): its float fields
+    // convert exactly, so the restart is bit-identical too.
+    using P = TestType;
+    using Real = sphere_test::user_real<P>;
     temp_folder dir;
     const std::string path = dir / "run.ck";
     const std::size_t n_before = 600, n_after = 600;
 
-    host_sim<Real> original = eventful_run<Real>(n_before);
+    host_sim<P> original = eventful_run<P>(n_before);
     const sphere::simulation_state<Real> at_checkpoint = original.state();
     sphere::write_checkpoint(path, original);
     const std::size_t rebuilds_before = original.rebuilds();
     original.run(n_after);
 
-    host_sim<Real> restarted = sphere::restart<host_sim<Real>>(path);
+    host_sim<P> restarted = sphere::restart<host_sim<P>>(path);
     // The restored simulation starts from exactly the checkpointed state and settings.
     require_identical(restarted.state(), at_checkpoint);
     CHECK(restarted.dt() == original.dt());

@@ -95,12 +95,13 @@ Real z_for_overlap(double target)
 /// Two set-P spheres, A (index 0) at the origin and B (index 1) on +z at overlap 1e-4 m
 /// (F_n = k_n 1e-4 = 10 N, gamma_n = 0), both motion::prescribed, k_t = 2/7 k_n = 28571.43 N/m,
 /// gamma_t = 0, no gravity; dt = 2.5e-5 s so that each 5e-4 m leg at 0.01 m/s is 2000 steps.
-template <class Real>
+template <class P>
 struct shear_pair {
+    using Real = sphere_test::user_real<P>;
     static constexpr double dt_set = 2.5e-5;
     static constexpr std::size_t A = 0, B = 1;
 
-    sphere::simulation<Real> sim;
+    sphere::simulation<P> sim;
     double dt;
     double work = 0; ///< work done by the drive on the pair so far, sum (f_drive . v + tau_drive . omega) dt (J)
 
@@ -116,7 +117,7 @@ struct shear_pair {
     std::vector<sample> log;
     double s = 0;
 
-    static sphere::simulation<Real> make(Real mu_s, Real mu_d)
+    static sphere::simulation<P> make(Real mu_s, Real mu_d)
     {
         sphere::settings<Real> st = box_settings<Real>(); // walls at +-0.1 m: never touched
         st.contact.k_t = set_p<Real>::k_n * Real(2) / Real(7);
@@ -126,7 +127,7 @@ struct shear_pair {
         sphere::particle<Real> a = ball<Real>({0, 0, 0});
         sphere::particle<Real> b = ball<Real>({0, 0, z_for_overlap<Real>(1e-4)});
         a.kind = b.kind = sphere::motion::prescribed;
-        return sphere::simulation<Real>(st, {a, b});
+        return sphere::simulation<P>(st, {a, b});
     }
 
     shear_pair(Real mu_s, Real mu_d) : sim(make(mu_s, mu_d)), dt(static_cast<double>(sim.dt())) {}
@@ -207,14 +208,15 @@ double parallelogram(double s, std::size_t leg_index, double amp, double k, doub
 // =============================================================================================
 // D7: sliding to rolling on a floor
 // =============================================================================================
-TEMPLATE_TEST_CASE("D7 sphere sliding to rolling on a floor", "[tangential][wall][D7]", float, double)
+TEMPLATE_TEST_CASE("D7 sphere sliding to rolling on a floor", "[tangential][wall][D7]", float, double, sphere::mixed)
 {
-    using Real = TestType;
+    using P = TestType;
+    using Real = sphere_test::user_real<P>;
     sphere::settings<Real> st = floor_world<Real>(Real(100));
     st.gravity = {0, 0, Real(-g_earth)};
     const Real m = set_p<Real>::mass();
     const Real overlap0 = m * Real(g_earth) / set_p<Real>::k_n; // m g / k_n = 1.0273e-6 m: at rest on the floor
-    sphere::simulation<Real> sim(st, {ball<Real>({0, 0, set_p<Real>::radius - overlap0}, {1, 0, 0})});
+    sphere::simulation<P> sim(st, {ball<Real>({0, 0, set_p<Real>::radius - overlap0}, {1, 0, 0})});
     const double dt = sim.dt();
     const double L = 0.1;
 
@@ -306,9 +308,10 @@ struct incline_result {
 /// with gravity g (sin(theta) e_axis - cos(theta) e_z), axis 0 (x) or 1 (y). Accelerations
 /// are measured as velocity differences between t = 0.01 s and t = 0.05 s (after the
 /// start-up transient of the tangential contact, ~1e-4 s).
-template <class Real>
+template <class P>
 incline_result incline(double deg, int axis)
 {
+    using Real = sphere_test::user_real<P>;
     sphere::settings<Real> st = floor_world<Real>(Real(100)); // gamma_wt = 100 N s/m as in D6/D7
     const double th = deg * pi_d / 180;
     vec3<double> down_slope{0, 0, 0};
@@ -317,7 +320,7 @@ incline_result incline(double deg, int axis)
                   Real(-g_earth * std::cos(th))};
     const Real m = set_p<Real>::mass();
     const Real overlap0 = static_cast<Real>(static_cast<double>(m) * g_earth * std::cos(th) / 1e5);
-    sphere::simulation<Real> sim(st, {ball<Real>({0, 0, set_p<Real>::radius - overlap0})});
+    sphere::simulation<P> sim(st, {ball<Real>({0, 0, set_p<Real>::radius - overlap0})});
     const vec3<double> spin_axis = cross(vec3<double>{0, 0, 1}, down_slope); // omega of rolling down-slope
     const double dt = sim.dt();
     const std::size_t k1 = static_cast<std::size_t>(std::lround(0.01 / dt));
@@ -339,16 +342,16 @@ incline_result incline(double deg, int axis)
 } // namespace
 
 TEMPLATE_TEST_CASE("D8 sphere on an incline rolls at 20 deg and slides at 60 deg", "[tangential][wall][D8]", float,
-                   double)
+                   double, sphere::mixed)
 {
-    using Real = TestType;
+    using P = TestType;
     for (int axis = 0; axis < 2; ++axis) {
         SECTION(axis == 0 ? "tilt along x" : "tilt along y")
         {
             {
                 // 20 deg: (2/7) tan 20 = 0.104 < mu_w = 0.3, so it rolls: a = 5/7 g sin = 2.396584 m/s^2
                 // and alpha = a / R (the arm is R - overlap0, 1e-4 R shorter: 0.01 %, below 0.5 %).
-                const incline_result r = incline<Real>(20, axis);
+                const incline_result r = incline<P>(20, axis);
                 INFO(std::setprecision(8)
                      << "20 deg, axis " << axis << ": a = " << r.a << " m/s^2 (ref 2.396584), alpha = " << r.alpha
                      << " rad/s^2 (ref " << 2.396584 / 0.01 << ")");
@@ -360,7 +363,7 @@ TEMPLATE_TEST_CASE("D8 sphere on an incline rolls at 20 deg and slides at 60 deg
             {
                 // 60 deg: tan 60 > 3.5 mu_w, it slides: a = g (sin - mu cos) = 7.024209 m/s^2,
                 // alpha = mu g cos R m / I = 367.875 rad/s^2.
-                const incline_result r = incline<Real>(60, axis);
+                const incline_result r = incline<P>(60, axis);
                 INFO(std::setprecision(8) << "60 deg, axis " << axis << ": a = " << r.a
                                           << " m/s^2 (ref 7.024209), alpha = " << r.alpha << " rad/s^2 (ref 367.875)");
                 CHECK(rel_err(r.a, 7.024209) < 5e-3);
@@ -383,19 +386,20 @@ constexpr double d9_ds = d9_amp / d9_leg; // 2.5e-7 m of travel per step
 
 /// Relative tolerance of the Coulomb plateau: 1e-9 (double); float 1e-5 (its 24-bit mantissa
 /// and the representable overlap, 1.7e-6 off 1e-4 m).
-template <class Real>
+template <class P>
 double plateau_tol()
 {
-    return std::is_same<Real, float>::value ? 1e-5 : 1e-9;
+    return sphere_test::single_fields<P> ? 1e-5 : 1e-9;
 }
 } // namespace
 
-TEMPLATE_TEST_CASE("D9 cyclic tangential loading with mu = 0.3", "[tangential][pair][D9]", float, double)
+TEMPLATE_TEST_CASE("D9 cyclic tangential loading with mu = 0.3", "[tangential][pair][D9]", float, double, sphere::mixed)
 {
-    using Real = TestType;
+    using P = TestType;
+    using Real = sphere_test::user_real<P>;
     const drive mode = GENERATE(drive::spin, drive::orbit);
     INFO((mode == drive::spin ? "drive: B spins in place" : "drive: B translates tangentially"));
-    shear_pair<Real> pair(Real(0.3), Real(0.3));
+    shear_pair<P> pair(Real(0.3), Real(0.3));
     const double Fc = 3.0; // mu F_n = 0.3 * 10 N
     // Virgin loading to +amp, then one full cycle +amp -> -amp -> +amp.
     for (std::size_t k = 1; k <= 5 * d9_leg; ++k) pair.drive_to(mode, triangle(k, d9_leg, d9_amp));
@@ -405,7 +409,7 @@ TEMPLATE_TEST_CASE("D9 cyclic tangential loading with mu = 0.3", "[tangential][p
     // Normal force stays 10 N: spin keeps the geometry; orbit keeps it up to the rounding of the
     // positions on the circle (float: ulp(0.0199 m) = 1.9e-9 m of 1e-4 m overlap).
     const bool exact_geometry = mode == drive::spin;
-    const double fn_tol = exact_geometry ? plateau_tol<Real>() : (std::is_same<Real, float>::value ? 5e-5 : 1e-9);
+    const double fn_tol = exact_geometry ? plateau_tol<P>() : (sphere_test::single_fields<P> ? 5e-5 : 1e-9);
     double fn_err = 0;
     for (const auto& x : log) fn_err = std::max(fn_err, std::abs(x.fn - 10.0) / 10.0);
     INFO(std::setprecision(8) << "max |F_n - 10 N| / 10 N = " << fn_err);
@@ -414,7 +418,7 @@ TEMPLATE_TEST_CASE("D9 cyclic tangential loading with mu = 0.3", "[tangential][p
     // 1. The whole loop against the analytic parallelogram, sample by sample (turning points are
     //    hit exactly, so there is no discretisation error). Float: the elastic branches sum ~800
     //    rounded increments (5e-6 measured) and the orbit's F_n is off by up to 2e-5 (above).
-    const double loop_tol = std::is_same<Real, float>::value ? 5e-5 : 1e-9;
+    const double loop_tol = sphere_test::single_fields<P> ? 5e-5 : 1e-9;
     double loop_err = 0;
     for (std::size_t k = 0; k < log.size(); ++k) {
         const std::size_t leg_index = k < d9_leg ? 0 : 1 + (k - d9_leg) / (2 * d9_leg);
@@ -442,14 +446,14 @@ TEMPLATE_TEST_CASE("D9 cyclic tangential loading with mu = 0.3", "[tangential][p
                                   << " points (ref k_t = " << d9_kt << ")");
         CHECK(n > 800); // 2.1e-4 m / 2.5e-7 m = 840 steps
         // Round-off only (float: the summed increments, as above).
-        CHECK(rel_err(slope, d9_kt) < (std::is_same<Real, float>::value ? 1e-4 : 1e-8));
+        CHECK(rel_err(slope, d9_kt) < (sphere_test::single_fields<P> ? 1e-4 : 1e-8));
     }
 
     // 3. Plateau +-3 N wherever the parallelogram slides, and slip onsets at the right places.
     // The plateau is checked against 3 N and, as the Coulomb law itself, against mu |F_n| of the
     // same step. With the orbit drive in float, F_n is only 10 N to 2e-5 (the rounding of B's
     // position on the circle, see above), so there the 3 N check gets that allowance.
-    const double plateau_3n_tol = plateau_tol<Real>() + (exact_geometry ? 0 : fn_tol);
+    const double plateau_3n_tol = plateau_tol<P>() + (exact_geometry ? 0 : fn_tol);
     double plateau_err = 0, coulomb_err = 0;
     std::size_t sliding = 0;
     double s_slip_virgin = -1, s_slip_unload = -1;
@@ -473,7 +477,7 @@ TEMPLATE_TEST_CASE("D9 cyclic tangential loading with mu = 0.3", "[tangential][p
     CHECK(sliding > 3000); // (5e-4 - 1.05e-4) + 2 (1e-3 - 2.1e-4) = 1.975e-3 m = 7900 steps
     INFO(std::setprecision(8) << "Coulomb error | |f_t| - mu F_n | / (mu F_n) = " << coulomb_err);
     CHECK(plateau_err < plateau_3n_tol);
-    CHECK(coulomb_err < plateau_tol<Real>());
+    CHECK(coulomb_err < plateau_tol<P>());
     // Slip starts within one step of travel (2.5e-7 m) of F_c / k_t = 1.05e-4 m, and on
     // unloading 2 F_c / k_t = 2.1e-4 m after the reversal.
     CHECK(std::abs(s_slip_virgin - 1.05e-4) <= d9_ds * 1.001);
@@ -493,12 +497,13 @@ TEMPLATE_TEST_CASE("D9 cyclic tangential loading with mu = 0.3", "[tangential][p
 }
 
 TEMPLATE_TEST_CASE("D9 cyclic tangential loading with mu_s = 0.4 and mu_d = 0.3", "[tangential][pair][D9]", float,
-                   double)
+                   double, sphere::mixed)
 {
-    using Real = TestType;
+    using P = TestType;
+    using Real = sphere_test::user_real<P>;
     const drive mode = GENERATE(drive::spin, drive::orbit);
     INFO((mode == drive::spin ? "drive: B spins in place" : "drive: B translates tangentially"));
-    shear_pair<Real> pair(Real(0.4), Real(0.3));
+    shear_pair<P> pair(Real(0.4), Real(0.3));
     for (std::size_t k = 1; k <= 3 * d9_leg; ++k) pair.drive_to(mode, triangle(k, d9_leg, d9_amp));
     const auto& log = pair.log;
     // Static limit mu_s F_n = 4 N, reached at 4 / k_t = 1.4e-4 m; then sliding at mu_d F_n = 3 N.
@@ -506,7 +511,7 @@ TEMPLATE_TEST_CASE("D9 cyclic tangential loading with mu_s = 0.4 and mu_d = 0.3"
     // 7 N / k_t = 2.45e-4 m, i.e. at s = 2.55e-4 m, then slides at -3 N.
     // Sampled peaks lie within one step of travel (k_t 2.5e-7 m = 7.1e-3 N, 0.18 %) below 4 N.
     const double kds = d9_kt * d9_ds;
-    const double tol = plateau_tol<Real>() + (mode == drive::orbit && std::is_same<Real, float>::value ? 5e-5 : 0);
+    const double tol = plateau_tol<P>() + (mode == drive::orbit && sphere_test::single_fields<P> ? 5e-5 : 0);
     for (int leg = 0; leg < 2; ++leg) {
         const std::size_t k0 = leg == 0 ? 0 : d9_leg, k1 = leg == 0 ? d9_leg : 3 * d9_leg;
         const double sign = leg == 0 ? 1 : -1;
@@ -532,10 +537,11 @@ TEMPLATE_TEST_CASE("D9 cyclic tangential loading with mu_s = 0.4 and mu_d = 0.3"
 }
 
 TEMPLATE_TEST_CASE("D9 rigid rotation of a stretched contact and a new contact", "[tangential][pair][D9]", float,
-                   double)
+                   double, sphere::mixed)
 {
-    using Real = TestType;
-    shear_pair<Real> pair(Real(0.3), Real(0.3));
+    using P = TestType;
+    using Real = sphere_test::user_real<P>;
+    shear_pair<P> pair(Real(0.3), Real(0.3));
     // Stretch to s = 5e-5 m (below the slip point): |f_t| = k_t s = 1.428571 N.
     for (std::size_t k = 1; k <= 200; ++k) pair.drive_to(drive::spin, 5e-5 * static_cast<double>(k) / 200);
     const double ft_ref = 1.428571;
@@ -617,7 +623,7 @@ TEMPLATE_TEST_CASE("D9 rigid rotation of a stretched contact and a new contact",
         }
         REQUIRE(separated);
         // Round-off bound on the extracted |f_t|: a few ulps of the 10 N normal force.
-        const double zero_tol = std::is_same<Real, float>::value ? 1e-5 : 1e-12;
+        const double zero_tol = sphere_test::single_fields<P> ? 1e-5 : 1e-12;
         double ft_max = 0;
         std::size_t in_contact = 0;
         for (std::size_t k = 0; k < leg; ++k) {

@@ -51,15 +51,16 @@ double mean_wall_force(Sim& sim, int f, std::size_t steps)
 } // namespace
 
 TEMPLATE_TEST_CASE("D10: a stress-controlled wall compresses a simple-cubic column by the analytic amount",
-                   "[walls][D10]", float, double)
+                   "[walls][D10]", float, double, sphere::mixed)
 {
-    using Real = TestType;
+    using P = TestType;
+    using Real = sphere_test::user_real<P>;
     auto [s, p] = d10_column<Real>(0);
     const double R = set_p<Real>::radius, sigma0 = 1e4, area = (8 * R) * (8 * R);
     s.walls[5].mode = sphere::wall_mode::stress;
     s.walls[5].stress = Real(sigma0);
     s.walls[5].mass = Real(0.05); // kg
-    sphere::simulation<Real> sim(s, p);
+    sphere::simulation<P> sim(s, p);
     sim.run(40000); // ~1 s: the column and the wall come to rest
     // Each of the 16 columns carries sigma0 A / 16 = 4 N through 11 contacts (9 pairs, floor,
     // wall): compression 11 * 4 N / k_n = 4.4e-4 m. Tolerance 0.1% (VALIDATION D10).
@@ -72,15 +73,16 @@ TEMPLATE_TEST_CASE("D10: a stress-controlled wall compresses a simple-cubic colu
     CHECK(double(sphere::wall_area(sim.walls(), s.box, 5)) == Approx(area).epsilon(1e-6));
 }
 
-TEMPLATE_TEST_CASE("D10: with gravity the floor carries the wall stress plus the weight", "[walls][D10]", float, double)
+TEMPLATE_TEST_CASE("D10: with gravity the floor carries the wall stress plus the weight", "[walls][D10]", float, double, sphere::mixed)
 {
-    using Real = TestType;
+    using P = TestType;
+    using Real = sphere_test::user_real<P>;
     auto [s, p] = d10_column<Real>(Real(9.81));
     const double R = set_p<Real>::radius, area = (8 * R) * (8 * R);
     s.walls[5].mode = sphere::wall_mode::stress;
     s.walls[5].stress = Real(1e4);
     s.walls[5].mass = Real(0.05);
-    sphere::simulation<Real> sim(s, p);
+    sphere::simulation<P> sim(s, p);
     sim.run(40000);
     // 1e4 Pa * 0.0064 m^2 + 160 * 1.047198e-2 kg * 9.81 m/s^2 = 80.437 N (VALIDATION D10), 0.1%.
     const double floor_force = -mean_wall_force(sim, 4, 2000);
@@ -88,9 +90,10 @@ TEMPLATE_TEST_CASE("D10: with gravity the floor carries the wall stress plus the
     CHECK(floor_force == Approx(80.437).epsilon(1e-3));
 }
 
-TEMPLATE_TEST_CASE("D10: a velocity-controlled wall gives the analytic stress", "[walls][D10]", float, double)
+TEMPLATE_TEST_CASE("D10: a velocity-controlled wall gives the analytic stress", "[walls][D10]", float, double, sphere::mixed)
 {
-    using Real = TestType;
+    using P = TestType;
+    using Real = sphere_test::user_real<P>;
     auto [s, p] = d10_column<Real>(0);
     const double R = set_p<Real>::radius, area = (8 * R) * (8 * R);
     // Move the wall down 1.3 mm at 2 mm/s (quasi-static: far below the column's wave speed),
@@ -99,7 +102,7 @@ TEMPLATE_TEST_CASE("D10: a velocity-controlled wall gives the analytic stress", 
     down.mode = sphere::wall_mode::velocity;
     down.velocity = Real(0.002);
     s.walls[5] = down;
-    sphere::simulation<Real> sim(s, p);
+    sphere::simulation<P> sim(s, p);
     const std::size_t moving = static_cast<std::size_t>(std::lround(0.65 / double(sim.dt())));
     sim.run(moving);
     sim.set_wall_control(5, sphere::wall_control<Real>{}); // fixed from now on
@@ -117,7 +120,8 @@ TEMPLATE_TEST_CASE("D10: a velocity-controlled wall gives the analytic stress", 
 TEMPLATE_TEST_CASE("a stress-controlled wall holds its target on a random sample, also sine-modulated",
                    "[walls][slow]", float, double)
 {
-    using Real = TestType;
+    using P = TestType;
+    using Real = sphere_test::user_real<P>;
     // 1000 polydisperse spheres (radii 0.8-1.2 R) on a jittered lattice, periodic x/y, with
     // friction and damping, under a stress-controlled upper wall.
     const Real R = set_p<Real>::radius, spacing = Real(2.5) * R;
@@ -140,7 +144,7 @@ TEMPLATE_TEST_CASE("a stress-controlled wall holds its target on a random sample
     s.walls[5].mode = sphere::wall_mode::stress;
     s.walls[5].stress = Real(sigma0);
     s.walls[5].mass = Real(0.5);
-    sphere::simulation<Real> sim(s, p);
+    sphere::simulation<P> sim(s, p);
     sim.run(30000); // consolidation
     // Time-averaged over a window the wall holds sigma0 within 1% (issue 3, test 1).
     const double held = mean_wall_force(sim, 5, 4000) / area;
@@ -165,9 +169,10 @@ TEMPLATE_TEST_CASE("a stress-controlled wall holds its target on a random sample
     CHECK(max_dev < 0.05 * sigma0);
 }
 
-TEMPLATE_TEST_CASE("the energy budget closes with a moving wall", "[walls][energy]", float, double)
+TEMPLATE_TEST_CASE("the energy budget closes with a moving wall", "[walls][energy]", float, double, sphere::mixed)
 {
-    using Real = TestType;
+    using P = TestType;
+    using Real = sphere_test::user_real<P>;
     // A 0.1 kg stress-controlled wall (1e4 Pa) slams onto the damped D10 column at ~1 m/s and
     // bounces: kinetic + rotational + potential + elastic + dissipated - boundary work stays
     // constant up to the O(dt) error of booking the dashpots' dissipation (as D3). Measured
@@ -178,7 +183,7 @@ TEMPLATE_TEST_CASE("the energy budget closes with a moving wall", "[walls][energ
         s.walls[5].stress = Real(1e4);
         s.walls[5].mass = Real(0.1);
         s.dt = dt_factor * set_p<Real>::dt();
-        sphere::simulation<Real> sim(s, p);
+        sphere::simulation<P> sim(s, p);
         const double total0 = double(sim.energy().total());
         sim.run(static_cast<std::size_t>(std::lround(0.1 / double(sim.dt()))));
         const auto e = sim.energy();
@@ -191,11 +196,12 @@ TEMPLATE_TEST_CASE("the energy budget closes with a moving wall", "[walls][energ
     CHECK(at_quarter < at_dt / 3); // first order: 4x smaller dt, ~4x smaller error
 }
 
-TEMPLATE_TEST_CASE("bad wall controls are refused with the face named", "[walls][errors]", float, double)
+TEMPLATE_TEST_CASE("bad wall controls are refused with the face named", "[walls][errors]", float, double, sphere::mixed)
 {
-    using Real = TestType;
+    using P = TestType;
+    using Real = sphere_test::user_real<P>;
     auto [s, p] = d10_column<Real>(0);
-    auto build = [&](const sphere::settings<Real>& t) { sphere::simulation<Real> sim(t, p); };
+    auto build = [&](const sphere::settings<Real>& t) { sphere::simulation<P> sim(t, p); };
     SECTION("a moving wall on a periodic axis")
     {
         s.walls[0].mode = sphere::wall_mode::velocity;
@@ -216,12 +222,12 @@ TEMPLATE_TEST_CASE("bad wall controls are refused with the face named", "[walls]
     {
         s.walls[5].mode = sphere::wall_mode::velocity;
         s.walls[5].velocity = Real(-1); // outwards, 1 m/s: leaves the 1 mm margin in ~40 steps
-        sphere::simulation<Real> sim(s, p);
+        sphere::simulation<P> sim(s, p);
         REQUIRE_THROWS_WITH(sim.run(100), Catch::Contains("wall face 5 moved to") && Catch::Contains("outside the world"));
     }
     SECTION("set_wall_control checks the same")
     {
-        sphere::simulation<Real> sim(s, p);
+        sphere::simulation<P> sim(s, p);
         sphere::wall_control<Real> c;
         c.mode = sphere::wall_mode::stress;
         REQUIRE_THROWS_WITH(sim.set_wall_control(5, c), Catch::Contains("settings.walls[5].mass = 0 kg"));
@@ -230,15 +236,16 @@ TEMPLATE_TEST_CASE("bad wall controls are refused with the face named", "[walls]
 }
 
 TEMPLATE_TEST_CASE("set_wall_position moves a wall onto the sample and refuses impossible places", "[walls][errors]",
-                   float, double)
+                   float, double, sphere::mixed)
 {
-    using Real = TestType;
+    using P = TestType;
+    using Real = sphere_test::user_real<P>;
     auto [s, p] = d10_column<Real>(0);
     const double R = set_p<Real>::radius, top = 20 * R; // highest particle point
     s.box.hi.z = Real(0.5);                          // plenty of headroom above the column
     s.walls[5].mode = sphere::wall_mode::velocity;
     s.walls[5].velocity = Real(0.01);
-    sphere::simulation<Real> sim(s, p);
+    sphere::simulation<P> sim(s, p);
     // Wall faces 0-3 lie on periodic axes.
     CHECK_THROWS_WITH(sim.set_wall_position(0, 0.01), Catch::Contains("axis 0 is periodic, so face 0 has no wall"));
     CHECK_THROWS_WITH(sim.set_wall_position(6, 0.01), Catch::Contains("face 6 out of range"));

@@ -19,6 +19,7 @@
 #include "core/config.cuh"
 #include "core/constants.cuh"
 #include "core/error.cuh"
+#include "core/precision.cuh"
 #include "core/vec.cuh"
 #include "exec/algorithms.cuh"
 #include "exec/buffer.cuh"

@@ -34,9 +34,10 @@ namespace detail {
 /// m a - f - m g and its torque -t (a = 0 for motion::prescribed, a = f_z / m along z for
 /// motion::prescribed_horizontal), and its power is their product with the velocities at the
 /// positions' time (docs/physics.md, "Driven particles").
-template <class Real>
+template <class P>
 struct drive_power {
-    particle_view<Real> p;
+    using Real = real_t<P>;
+    particle_view<P> p;
     vec3<Real> gravity;
     SPHERE_HD double operator()(std::size_t i) const
     {
@@ -48,9 +49,10 @@ struct drive_power {
     }
 };
 
-template <class Real>
+template <class P>
 struct set_kinematics {
-    particle_view<Real> p;
+    using Real = real_t<P>;
+    particle_view<P> p;
     std::size_t index; ///< storage slot
     vec3<Real> v, omega;
     SPHERE_HD void operator()(std::size_t) const
@@ -79,7 +81,10 @@ struct simulation_state {
 
 /// A DEM simulation of spheres.
 ///
-/// \tparam Real       float or double
+/// \tparam Precision  float, double or sphere::mixed (core/precision.cuh): every value the
+///                    simulation takes and hands out (settings, particles, snapshots, energies)
+///                    is a real_type = coord_t<Precision>; with mixed, positions and walls are
+///                    double and the particles' other fields and the contact laws float
 /// \tparam Policy     sphere::host or sphere::cuda
 /// \tparam Law        contact law policy, e.g. contact::linear<tangential::visco_frictional>
 /// \tparam Integrator integrate::semi_implicit_euler (default), velocity_verlet, taylor2 or
@@ -92,16 +97,22 @@ struct simulation_state {
 /// sphere::error naming the step and the particle's user index); advance time; call the
 /// observers that are due. Velocity Verlet drifts the particles first and checks them before
 /// the forces (docs/architecture.md, "One step").
-template <class Real, class Policy = host, class Law = contact::linear<>,
+template <class Precision, class Policy = host, class Law = contact::linear<>,
           class Integrator = integrate::semi_implicit_euler>
 class simulation {
+    using Real = real_t<Precision>;  ///< particle fields other than positions, contact laws
+    using Coord = coord_t<Precision>; ///< positions, walls, the world, user-facing values
+
 public:
-    using real_type = Real;
+    using precision_type = Precision;
+    using real_type = Coord;
     using policy_type = Policy;
     using observer = std::function<void(const simulation&)>;
 
     /// Validates everything and builds the first contact lists; throws sphere::error on bad input.
-    simulation(const settings<Real>& s, std::vector<particle<Real>> particles) : settings_(s)
+    simulation(const settings<Coord>& s, std::vector<particle<Coord>> particles)
+        : settings_(s), pair_params_(params_cast<Real>(s.contact)), wall_params_(params_cast<Real>(s.wall)),
+          gravity_(vec_cast<Real>(s.gravity))
     {
         validate_world(s.box);
         Law::validate(s.contact, s.wall);
@@ -115,16 +126,16 @@ public:
         if (particles.empty()) detail::fail("no particles: a simulation needs at least one");
         validate_particles(particles, s.box);
 
-        Real min_mass = 0, max_radius = 0;
+        Coord min_mass = 0, max_radius = 0;
         for (std::size_t i = 0; i < particles.size(); ++i) {
-            particle<Real>& p = particles[i];
+            particle<Coord>& p = particles[i];
             for (int a = 0; a < 3; ++a) p.position[a] = s.box.wrap(p.position[a], a);
-            const Real m = sphere_mass(p.radius, p.density);
+            const Coord m = sphere_mass(p.radius, p.density);
             min_mass = i == 0 || m < min_mass ? m : min_mass;
             max_radius = p.radius > max_radius ? p.radius : max_radius;
         }
-        const Real bound = stable_time_step_bound(min_mass, s.contact, s.wall);
-        if (s.dt == Real(0)) {
+        const Coord bound = stable_time_step_bound(min_mass, s.contact, s.wall);
+        if (s.dt == Coord(0)) {
             dt_ = default_time_step(min_mass, s.contact, s.wall);
         } else if (!(s.dt > 0) || !std::isfinite(s.dt)) {
             detail::fail("settings.dt = ", s.dt, " s: must be positive and finite (0 = automatic)");
@@ -134,15 +145,16 @@ public:
         } else {
             dt_ = s.dt;
         }
+        dt_ = Coord(Real(dt_)); // the kernels step velocities with dt in Real: one dt throughout
 
-        particles_ = particle_state<Real, Policy>(particles);
-        for (const particle<Real>& p : particles) {
+        particles_ = particle_state<Precision, Policy>(particles);
+        for (const particle<Coord>& p : particles) {
             kinds_.push_back(p.kind);
             if (p.kind == motion::prescribed || p.kind == motion::prescribed_horizontal) drive_ = true;
         }
-        walls_ = wall_set<Real>::from_world(s.box);
-        grid_ = neighbor_grid<Real, Policy>(grid_geometry<Real>::make(s.box, 2 * max_radius + s.skin, s.cell_size));
-        lists_ = contact_lists<Real, Policy>(particles.size(), s.contact_forces);
+        walls_ = wall_set<Coord>::from_world(s.box);
+        grid_ = neighbor_grid<Coord, Policy>(grid_geometry<Coord>::make(s.box, 2 * max_radius + s.skin, s.cell_size));
+        lists_ = contact_lists<Precision, Policy>(particles.size(), s.contact_forces);
         x_at_build_.resize(particles.size());
         rebuild_lists();
         // An integrator that kicks before the forces needs the forces of the start.
@@ -152,26 +164,30 @@ public:
     /// One DEM step of length dt().
     void step()
     {
-        const particle_view<Real> p = particles_.view();
+        // Views hold raw pointers into arrays that a rebuild permutes in place (their
+        // addresses stay), and external forces are permuted along with the particles.
+        const particle_view<Precision> p = particles_.view();
         const std::size_t n = p.n;
         const vec3<Real>* external = external_.size() ? external_.data() : nullptr;
+        const detail::integrate_particles<Precision, Integrator> integrate{p, settings_.box, gravity_, Real(dt_), external};
+        detail::step_check<Coord> check{0, ~std::size_t(0)};
+        // The particle check runs in the same pass as the motion: after the drift (velocity
+        // Verlet) or after the integration.
         if constexpr (Integrator::drifts_before_forces) {
-            for_each_index(Policy{}, n,
-                           detail::drift_particles<Real, Integrator>{p, settings_.box, settings_.gravity, dt_, external});
-            check_particles(steps_ + 1);
+            check = checked(detail::drift_particles<Precision, Integrator>{p, settings_.box, gravity_, Real(dt_), external});
+            judge(check, steps_ + 1);
         }
         if (needs_rebuild_) rebuild_lists();
         const detail::wall_loads loads = interact(true);
-        const particle_view<Real> q = particles_.view(); // the rebuild may have permuted the particles
-        for_each_index(Policy{}, n, detail::integrate_particles<Real, Integrator>{q, settings_.box, settings_.gravity, dt_,
-                                                                               external_.size() ? external_.data() : nullptr});
+        if constexpr (Integrator::drifts_before_forces) for_each_index(Policy{}, n, integrate);
+        else check = checked(integrate);
         advance_walls(walls_, settings_.walls, settings_.box, loads.force, time_, dt_, steps_ + 1);
         if (drive_)
-            drive_work_ += transform_reduce(Policy{}, n, detail::drive_power<Real>{q, settings_.gravity}, 0.0, plus_op{}) *
+            drive_work_ += transform_reduce(Policy{}, n, detail::drive_power<Precision>{p, gravity_}, 0.0, plus_op{}) *
                            double(dt_);
         ++steps_;
         time_ = static_cast<double>(steps_) * static_cast<double>(dt_);
-        if constexpr (!Integrator::drifts_before_forces) check_particles(steps_);
+        if constexpr (!Integrator::drifts_before_forces) judge(check, steps_);
         for (const auto& o : observers_)
             if (steps_ % o.first == 0) o.second(*this);
     }
@@ -191,7 +207,7 @@ public:
 
     /// Sets the velocity (m/s) and angular velocity (rad/s) of particle i; a prescribed
     /// particle keeps them until set again. Throws for a fixed particle or non-finite values.
-    void set_velocity(std::size_t i, const vec3<Real>& v, const vec3<Real>& omega)
+    void set_velocity(std::size_t i, const vec3<Coord>& v, const vec3<Coord>& omega)
     {
         if (i >= size()) detail::fail("set_velocity: particle index ", i, " out of range (", size(), " particles)");
         if (kinds_[i] == motion::fixed)
@@ -201,16 +217,17 @@ public:
                          ") m/s or angular velocity (", omega.x, ", ", omega.y, ", ", omega.z, ") rad/s is not finite");
         const std::vector<unsigned> user = particles_.user_indices();
         const std::size_t slot = static_cast<std::size_t>(std::find(user.begin(), user.end(), unsigned(i)) - user.begin());
-        for_each_index(Policy{}, 1, detail::set_kinematics<Real>{particles_.view(), slot, v, omega});
+        for_each_index(Policy{}, 1,
+                       detail::set_kinematics<Precision>{particles_.view(), slot, vec_cast<Real>(v), vec_cast<Real>(omega)});
     }
 
     /// Changes how wall face f moves from the next step on (e.g. from consolidation at a
     /// stress to a fixed wall); validated like settings.walls.
-    void set_wall_control(int f, const wall_control<Real>& control)
+    void set_wall_control(int f, const wall_control<Coord>& control)
     {
-        if (f < 0 || f >= wall_set<Real>::count) detail::fail("set_wall_control: face ", f, " out of range [0, 6)");
-        wall_control<Real> controls[wall_set<Real>::count];
-        for (int k = 0; k < wall_set<Real>::count; ++k) controls[k] = k == f ? control : settings_.walls[k];
+        if (f < 0 || f >= wall_set<Coord>::count) detail::fail("set_wall_control: face ", f, " out of range [0, 6)");
+        wall_control<Coord> controls[wall_set<Coord>::count];
+        for (int k = 0; k < wall_set<Coord>::count; ++k) controls[k] = k == f ? control : settings_.walls[k];
         validate_wall_controls(controls, settings_.box);
         settings_.walls[f] = control;
     }
@@ -221,7 +238,7 @@ public:
     /// centre would be outside the wall.
     void set_wall_position(int f, double position)
     {
-        if (f < 0 || f >= wall_set<Real>::count) detail::fail("set_wall_position: face ", f, " out of range [0, 6)");
+        if (f < 0 || f >= wall_set<Coord>::count) detail::fail("set_wall_position: face ", f, " out of range [0, 6)");
         const int a = f / 2;
         if (!walls_.face[f].active)
             detail::fail("set_wall_position: axis ", a, " is periodic, so face ", f, " has no wall");
@@ -232,7 +249,7 @@ public:
         if (f % 2 == 0 ? !(position < opposite) : !(position > opposite))
             detail::fail("set_wall_position: face ", f, " at ", position, " m would cross the opposite wall at ",
                          opposite, " m");
-        const particle_snapshot<Real> s = particles_.snapshot();
+        const particle_snapshot<Coord> s = particles_.snapshot();
         for (std::size_t i = 0; i < s.size(); ++i) {
             const double x = double(s.position(i)[a]);
             if (f % 2 == 0 ? x < position : x > position)
@@ -245,30 +262,30 @@ public:
     }
 
     std::size_t size() const { return particles_.size(); }
-    Real dt() const { return dt_; }
+    Coord dt() const { return dt_; }
     /// Simulated time (s), steps() * dt() in double.
     double time() const { return time_; }
     std::size_t steps() const { return steps_; }
     /// How many times the grid and contact lists were built (including at setup).
     std::size_t rebuilds() const { return rebuilds_; }
-    const settings<Real>& config() const { return settings_; }
-    const wall_set<Real>& walls() const { return walls_; }
+    const settings<Coord>& config() const { return settings_; }
+    const wall_set<Coord>& walls() const { return walls_; }
     /// Work done on the particles by whatever drives the prescribed ones, so far (J); part of
     /// energy().boundary_work, with the work of the walls.
     double drive_work() const { return drive_work_; }
-    const grid_geometry<Real>& grid() const { return grid_.geometry(); }
+    const grid_geometry<Coord>& grid() const { return grid_.geometry(); }
 
     /// A host copy of every particle field, in user order.
-    particle_snapshot<Real> snapshot() const { return particles_.snapshot(); }
+    particle_snapshot<Coord> snapshot() const { return particles_.snapshot(); }
     /// A host copy of the contact lists, in user order (forces only with settings.contact_forces).
-    contact_table<Real> contacts() const { return lists_.table(particles_.user_indices()); }
+    contact_table<Coord> contacts() const { return lists_.table(particles_.user_indices()); }
     /// Entries in the contact lists (pairs from both sides, and wall entries).
     std::size_t contact_entries() const { return lists_.entries(); }
 
     /// Kernel view of the particle fields (policy memory, storage order: `user` names each
     /// slot's particle), for couplings that read positions and velocities between steps (the
     /// pore fluid). The storage order changes at rebuilds. Writing through it is undefined.
-    particle_view<Real> particle_data() { return particles_.view(); }
+    particle_view<Precision> particle_data() { return particles_.view(); }
 
     /// External forces on the particles (N; policy memory, one per particle in storage order, which the
     /// simulation keeps in step with the particles when it reorders them), added
@@ -282,30 +299,30 @@ public:
     }
 
     /// Kinetic, rotational, potential and elastic energies and the dissipated energies (J).
-    energy_budget<Real> energy() const
+    energy_budget<Coord> energy() const
     {
         auto& self = const_cast<simulation&>(*this); // views hand out mutable pointers; nothing is written
-        energy_budget<Real> e = transform_reduce(
+        energy_budget<Coord> e = transform_reduce(
             Policy{}, size(),
-            detail::particle_energy<Real, Law>{self.particles_.view(), self.lists_.view(), settings_.box, walls_,
-                                               settings_.contact, settings_.wall, settings_.gravity},
-            energy_budget<Real>{}, plus_op{});
+            detail::particle_energy<Precision, Law>{self.particles_.view(), self.lists_.view(), settings_.box, walls_,
+                                                    pair_params_, wall_params_, settings_.gravity},
+            energy_budget<Coord>{}, plus_op{});
         double work = drive_work_;
-        for (const wall_face<Real>& w : walls_.face) work += w.work;
-        e.boundary_work = Real(work);
+        for (const wall_face<Coord>& w : walls_.face) work += w.work;
+        e.boundary_work = Coord(work);
         return e;
     }
 
     /// Everything that evolves, for checkpoints: with the same settings, `restore(state())`
     /// continues bit-identically.
-    simulation_state<Real> state() const
+    simulation_state<Coord> state() const
     {
         const std::vector<unsigned> user = particles_.user_indices();
-        contact_table<Real> contacts = lists_.table(user);
+        contact_table<Coord> contacts = lists_.table(user);
         contacts.force.clear();
-        std::vector<vec4<Real>> slots = x_at_build_.to_host(), x_at_build(slots.size());
+        std::vector<vec4<Coord>> slots = x_at_build_.to_host(), x_at_build(slots.size());
         for (std::size_t k = 0; k < slots.size(); ++k) x_at_build[user[k]] = slots[k];
-        simulation_state<Real> st;
+        simulation_state<Coord> st;
         st.particles = particles_.snapshot();
         st.contacts = std::move(contacts);
         st.x_at_build = std::move(x_at_build);
@@ -322,7 +339,7 @@ public:
     /// Continues from a state taken from a simulation with the same settings and particle count,
     /// possibly edited on the host (e.g. particles turned into a shear cell's driven layers by
     /// make_shear_cell: the motion kinds are taken from the state).
-    void restore(const simulation_state<Real>& s)
+    void restore(const simulation_state<Coord>& s)
     {
         if (s.particles.size() != size())
             detail::fail("restore: the state holds ", s.particles.size(), " particles, the simulation ", size());
@@ -349,7 +366,7 @@ public:
         particles_.restore(s.particles);
         const std::vector<unsigned> user = particles_.user_indices();
         lists_.restore(s.contacts, user);
-        std::vector<vec4<Real>> slots(size());
+        std::vector<vec4<Coord>> slots(size());
         for (std::size_t k = 0; k < size(); ++k) slots[k] = s.x_at_build[user[k]];
         x_at_build_.assign(slots);
         walls_ = s.walls;
@@ -362,11 +379,11 @@ public:
     }
 
     /// Total linear momentum, sum m v (kg m/s).
-    vec3<Real> momentum() const
+    vec3<Coord> momentum() const
     {
         auto& self = const_cast<simulation&>(*this);
-        return transform_reduce(Policy{}, size(), detail::particle_momentum<Real>{self.particles_.view()},
-                                vec3<Real>{0, 0, 0}, plus_op{});
+        return transform_reduce(Policy{}, size(), detail::particle_momentum<Precision>{self.particles_.view()},
+                                vec3<Coord>{0, 0, 0}, plus_op{});
     }
 
 private:
@@ -375,14 +392,14 @@ private:
     void rebuild_lists()
     {
         grid_.build(particles_.view());
-        const grid_view<Real> g = grid_.view();
+        const grid_view<Coord> g = grid_.view();
         lists_.rebuild(g, walls_, settings_.skin, particles_.view().user, !settings_.reorder);
         if (settings_.reorder) {
             particles_.permute(g.order);
             if (external_.size()) particles_.permute_along(external_, g.order);
         }
-        const particle_view<Real> p = particles_.view();
-        for_each_index(Policy{}, p.n, detail::copy_positions<Real>{p.x, x_at_build_.data()});
+        const particle_view<Precision> p = particles_.view();
+        for_each_index(Policy{}, p.n, detail::copy_positions<Coord>{p.x, x_at_build_.data()});
         walls_at_build_ = walls_;
         ++rebuilds_;
         needs_rebuild_ = false;
@@ -400,27 +417,35 @@ private:
     template <bool Book, bool Record>
     detail::wall_loads interact_with(bool update)
     {
-        const particle_view<Real> p = particles_.view();
+        const particle_view<Precision> p = particles_.view();
         return transform_reduce(Policy{}, p.n,
-                                detail::interact<Real, Law, Book, Record, Integrator::drifts_before_forces>{
-                                    p, lists_.view(), settings_.box, walls_, settings_.contact, settings_.wall, dt_,
+                                detail::interact<Precision, Law, Book, Record, Integrator::drifts_before_forces>{
+                                    p, lists_.view(), settings_.box, walls_, pair_params_, wall_params_, Real(dt_),
                                     update},
                                 detail::wall_loads{{0, 0, 0, 0, 0, 0}}, plus_op{});
     }
 
-    /// The post-motion check of every particle (a sphere::error naming step `step` and the
-    /// particle); marks the lists for a rebuild when a particle and a wall may have come closer
-    /// than the skin.
-    void check_particles(std::size_t step)
+    /// Runs the particle kernel `body` on every particle and checks each one after it, in one
+    /// pass (a particle outside the walls, non-finite values, the largest displacement since
+    /// the lists were built).
+    template <class Body>
+    detail::step_check<Coord> checked(const Body& body)
     {
-        const particle_view<Real> p = particles_.view();
-        const detail::step_check<Real> check = transform_reduce(
-            Policy{}, p.n, detail::check_particle<Real>{p, x_at_build_.data(), settings_.box, walls_},
-            detail::step_check<Real>{0, ~std::size_t(0)}, detail::combine_checks{});
+        const particle_view<Precision> p = particles_.view();
+        const detail::check_particle<Precision> check{p, x_at_build_.data(), settings_.box, walls_};
+        return transform_reduce(Policy{}, p.n, detail::then_check<Body, Precision>{body, check},
+                                detail::step_check<Coord>{0, ~std::size_t(0)}, detail::combine_checks{});
+    }
+
+    /// Acts on the particle check of step `step`: a sphere::error naming the step and the
+    /// particle; marks the lists for a rebuild when a particle and a wall may have come closer
+    /// than the skin.
+    void judge(const detail::step_check<Coord>& check, std::size_t step)
+    {
         if (check.first_bad != ~std::size_t(0)) report_bad_particle(check.first_bad, step);
         const double moved = std::sqrt(double(check.max_displacement2)), skin = double(settings_.skin);
         bool rebuild = 2 * moved > skin;
-        for (int f = 0; f < wall_set<Real>::count; ++f)
+        for (int f = 0; f < wall_set<Coord>::count; ++f)
             if (walls_.face[f].active && std::fabs(walls_.face[f].position - walls_at_build_.face[f].position) + moved > skin)
                 rebuild = true;
         needs_rebuild_ = needs_rebuild_ || rebuild;
@@ -429,8 +454,8 @@ private:
     /// Throws the error for particle i (a user index) at step `step`.
     [[noreturn]] void report_bad_particle(std::size_t i, std::size_t step) const
     {
-        const particle_snapshot<Real> s = particles_.snapshot();
-        const vec3<Real> x = s.position(i), v = s.v_sync[i];
+        const particle_snapshot<Coord> s = particles_.snapshot();
+        const vec3<Coord> x = s.position(i), v = s.v_sync[i];
         if (!isfinite(x) || !isfinite(v) || !isfinite(s.omega_sync[i]))
             detail::fail("step ", step, ": particle ", i, " became non-finite (position (", x.x, ", ", x.y, ", ",
                          x.z, ") m, velocity (", v.x, ", ", v.y, ", ", v.z, ") m/s); reduce the time step");
@@ -442,18 +467,20 @@ private:
                      walls_.face[5].position, "] m");
     }
 
-    settings<Real> settings_;
-    Real dt_ = 0;
+    settings<Coord> settings_;
+    contact_params<Real> pair_params_, wall_params_; ///< settings_.contact and .wall in the laws' precision
+    vec3<Real> gravity_;                             ///< settings_.gravity in the particles' precision
+    Coord dt_ = 0;
     double time_ = 0;
     double drive_work_ = 0; ///< work done on the prescribed particles so far (J)
     std::size_t steps_ = 0, rebuilds_ = 0;
     bool needs_rebuild_ = true;
-    particle_state<Real, Policy> particles_;
-    wall_set<Real> walls_;
-    neighbor_grid<Real, Policy> grid_;
-    contact_lists<Real, Policy> lists_;
-    buffer<vec4<Real>, Policy> x_at_build_;
-    wall_set<Real> walls_at_build_;       ///< the walls when the lists were built
+    particle_state<Precision, Policy> particles_;
+    wall_set<Coord> walls_;
+    neighbor_grid<Coord, Policy> grid_;
+    contact_lists<Precision, Policy> lists_;
+    buffer<vec4<Coord>, Policy> x_at_build_;
+    wall_set<Coord> walls_at_build_;      ///< the walls when the lists were built
     bool drive_ = false;                  ///< some particle is prescribed: book the drive's work
     buffer<vec3<Real>, Policy> external_; ///< external forces (empty until external_forces() is called)
     std::vector<motion> kinds_; ///< host copy of each particle's motion (it never changes)

@@ -7,6 +7,7 @@
 #include "../boundary/walls.cuh"
 #include "../boundary/world.cuh"
 #include "../contact/contact_lists.cuh"
+#include "../contact/interact.cuh"
 #include "../contact/params.cuh"
 #include "../particles/state.cuh"
 
@@ -48,37 +49,44 @@ struct energy_budget {
 namespace detail {
 
 /// Particle i's share of the energy budget: its own energies, its dissipation, half the
-/// elastic energy of each pair contact and all of its wall contacts.
-template <class Real, class Law>
+/// elastic energy of each pair contact and all of its wall contacts. Summed in coord_t<P>,
+/// the user-facing type; overlaps formed as in the interaction kernel.
+template <class P, class Law>
 struct particle_energy {
-    particle_view<Real> p;
+    using Real = real_t<P>;
+    using Coord = coord_t<P>;
+    particle_view<P> p;
     contact_view<Real> c;
-    world<Real> box;
-    wall_set<Real> walls;
+    world<Coord> box;
+    wall_set<Coord> walls;
     contact_params<Real> pair_params;
     contact_params<Real> wall_params;
-    vec3<Real> gravity;
+    vec3<Coord> gravity;
 
-    SPHERE_HD energy_budget<Real> operator()(std::size_t i) const
+    SPHERE_HD energy_budget<Coord> operator()(std::size_t i) const
     {
-        const vec4<Real> xi = p.x[i];
-        const Real m = p.mass[i];
-        energy_budget<Real> e;
-        e.kinetic = Real(0.5) * m * norm2(p.v_sync[i]);
-        e.rotational = Real(0.2) * m * xi.w * xi.w * norm2(p.omega_sync[i]);
+        const vec4<Coord> xi = p.x[i];
+        const Coord m = p.mass[i];
+        energy_budget<Coord> e;
+        e.kinetic = Coord(0.5) * m * Coord(norm2(p.v_sync[i]));
+        e.rotational = Coord(0.2) * m * xi.w * xi.w * Coord(norm2(p.omega_sync[i]));
         e.potential = -m * dot(gravity, xi.xyz());
         for (unsigned k = c.offset[i]; k < c.offset[i + 1]; ++k) {
             const unsigned j = c.partner[k];
             if (j < wall_partner_base) {
-                const vec4<Real> xj = p.x[j];
-                const Real delta_n = norm(box.nearest_image_inside(xi.xyz() - xj.xyz())) - (xi.w + xj.w);
-                if (delta_n < Real(0)) e.elastic += Law::pair_energy(pair_params, delta_n, c.history[k]) / 2;
+                const vec4<Coord> xj = p.x[j];
+                const vec3<Coord> d = box.nearest_image_inside(xi.xyz() - xj.xyz());
+                const Coord dist2 = norm2(d), reach = xi.w + xj.w;
+                if (!(dist2 < reach * reach)) continue;
+                vec3<Real> n;
+                const Real delta_n = overlap_and_normal(d, dist2, reach, n);
+                if (delta_n < Real(0)) e.elastic += Coord(Law::pair_energy(pair_params, delta_n, c.history[k]) / 2);
             } else {
                 const int f = static_cast<int>(j - wall_partner_base);
                 const int a = f / 2;
-                const Real delta_n =
-                    (xi.xyz()[a] - Real(walls.face[f].position)) * wall_set<Real>::inward_normal(f)[a] - xi.w;
-                if (delta_n < Real(0)) e.elastic += Law::wall_energy(wall_params, delta_n, c.history[k]);
+                const Real delta_n = Real((xi.xyz()[a] - Coord(walls.face[f].position)) *
+                                              Coord(wall_set<Real>::inward_normal(f)[a]) - xi.w);
+                if (delta_n < Real(0)) e.elastic += Coord(Law::wall_energy(wall_params, delta_n, c.history[k]));
             }
         }
         e.dissipated_visc = p.e_visc[i];
@@ -89,10 +97,13 @@ struct particle_energy {
     }
 };
 
-template <class Real>
+template <class P>
 struct particle_momentum {
-    particle_view<Real> p;
-    SPHERE_HD vec3<Real> operator()(std::size_t i) const { return p.v_sync[i] * p.mass[i]; }
+    particle_view<P> p;
+    SPHERE_HD vec3<coord_t<P>> operator()(std::size_t i) const
+    {
+        return vec_cast<coord_t<P>>(p.v_sync[i] * p.mass[i]);
+    }
 };
 
 } // namespace detail

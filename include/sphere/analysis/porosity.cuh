@@ -252,15 +252,15 @@ porosity_result bulk_porosity(const std::vector<vec4<Real>>& x, const world<Real
 }
 
 /// Bulk porosity of a simulation's particles between its walls.
-template <class Real, class Policy, class Law, class Integrator>
-porosity_result bulk_porosity(const simulation<Real, Policy, Law, Integrator>& sim)
+template <class P, class Policy, class Law, class Integrator, class Real = coord_t<P>>
+porosity_result bulk_porosity(const simulation<P, Policy, Law, Integrator>& sim)
 {
     return bulk_porosity(sim.snapshot().x, sim.config().box, sim.walls());
 }
 
 /// Porosity of a simulation's particles in the box [lo, hi] (m).
-template <class Real, class Policy, class Law, class Integrator>
-porosity_result bulk_porosity(const simulation<Real, Policy, Law, Integrator>& sim, const vec3<double>& lo,
+template <class P, class Policy, class Law, class Integrator, class Real = coord_t<P>>
+porosity_result bulk_porosity(const simulation<P, Policy, Law, Integrator>& sim, const vec3<double>& lo,
                               const vec3<double>& hi)
 {
     return porosity_in_box(sim.snapshot().x, sim.config().box, lo, hi);
@@ -296,8 +296,8 @@ std::vector<porosity_slice> porosity_profile(const std::vector<vec4<Real>>& x, c
 
 /// Porosity profile of a simulation's particles in `slices` horizontal slices between its
 /// walls (the whole period on periodic axes).
-template <class Real, class Policy, class Law, class Integrator>
-std::vector<porosity_slice> porosity_profile(const simulation<Real, Policy, Law, Integrator>& sim, std::size_t slices)
+template <class P, class Policy, class Law, class Integrator, class Real = coord_t<P>>
+std::vector<porosity_slice> porosity_profile(const simulation<P, Policy, Law, Integrator>& sim, std::size_t slices)
 {
     vec3<double> lo, hi;
     detail::between_walls(sim.walls(), sim.config().box, lo, hi);

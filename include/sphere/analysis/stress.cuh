@@ -32,8 +32,8 @@ double wall_normal_stress(const wall_set<Real>& walls, const world<Real>& box, i
 }
 
 /// Normal stress (Pa) on wall face f of a simulation, compressive positive.
-template <class Real, class Policy, class Law, class Integrator>
-double wall_normal_stress(const simulation<Real, Policy, Law, Integrator>& sim, int f)
+template <class P, class Policy, class Law, class Integrator, class Real = coord_t<P>>
+double wall_normal_stress(const simulation<P, Policy, Law, Integrator>& sim, int f)
 {
     return wall_normal_stress(sim.walls(), sim.config().box, f);
 }
@@ -68,8 +68,8 @@ struct contact_snapshot {
 /// those of the last step, the positions those after it: the analyses below are exact for a
 /// static assembly. Throws when the simulation records no contact forces
 /// (settings.contact_forces = false).
-template <class Real, class Policy, class Law, class Integrator>
-contact_snapshot<Real> take_contact_snapshot(const simulation<Real, Policy, Law, Integrator>& sim)
+template <class P, class Policy, class Law, class Integrator, class Real = coord_t<P>>
+contact_snapshot<Real> take_contact_snapshot(const simulation<P, Policy, Law, Integrator>& sim)
 {
     if (!sim.config().contact_forces)
         detail::fail("contact analyses need the contact forces: the simulation was set up with settings.contact_forces = false");
@@ -152,16 +152,16 @@ stress_tensor love_weber_stress(const contact_snapshot<Real>& c, double volume)
 }
 
 /// Love-Weber stress of a simulation over the volume between its walls.
-template <class Real, class Policy, class Law, class Integrator>
-stress_tensor love_weber_stress(const simulation<Real, Policy, Law, Integrator>& sim)
+template <class P, class Policy, class Law, class Integrator, class Real = coord_t<P>>
+stress_tensor love_weber_stress(const simulation<P, Policy, Law, Integrator>& sim)
 {
     const contact_snapshot<Real> c = take_contact_snapshot(sim);
     return love_weber_stress(c, volume_between_walls(c.walls, c.box));
 }
 
 /// Love-Weber stress of a simulation over a given volume (m^3).
-template <class Real, class Policy, class Law, class Integrator>
-stress_tensor love_weber_stress(const simulation<Real, Policy, Law, Integrator>& sim, double volume)
+template <class P, class Policy, class Law, class Integrator, class Real = coord_t<P>>
+stress_tensor love_weber_stress(const simulation<P, Policy, Law, Integrator>& sim, double volume)
 {
     return love_weber_stress(take_contact_snapshot(sim), volume);
 }
@@ -191,8 +191,8 @@ double mean_coordination(const contact_snapshot<Real>& c, bool with_walls = fals
 }
 
 /// Mean coordination number of a simulation's particles.
-template <class Real, class Policy, class Law, class Integrator>
-double mean_coordination(const simulation<Real, Policy, Law, Integrator>& sim, bool with_walls = false)
+template <class P, class Policy, class Law, class Integrator, class Real = coord_t<P>>
+double mean_coordination(const simulation<P, Policy, Law, Integrator>& sim, bool with_walls = false)
 {
     return mean_coordination(take_contact_snapshot(sim), with_walls);
 }
@@ -231,8 +231,8 @@ std::vector<contact_force> contact_network(const contact_snapshot<Real>& c)
 }
 
 /// The contact network of a simulation.
-template <class Real, class Policy, class Law, class Integrator>
-std::vector<contact_force> contact_network(const simulation<Real, Policy, Law, Integrator>& sim)
+template <class P, class Policy, class Law, class Integrator, class Real = coord_t<P>>
+std::vector<contact_force> contact_network(const simulation<P, Policy, Law, Integrator>& sim)
 {
     return contact_network(take_contact_snapshot(sim));
 }

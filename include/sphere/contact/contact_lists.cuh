@@ -16,6 +16,7 @@
 
 #include "../boundary/walls.cuh"
 #include "../core/error.cuh"
+#include "../core/precision.cuh"
 #include "../core/vec.cuh"
 #include "../exec/algorithms.cuh"
 #include "../exec/buffer.cuh"
@@ -174,9 +175,10 @@ struct fill_visit {
 
 /// Fills the new list of sorted position k, sorted by partner key, and carries over the
 /// history of the partners that the particle's old list (at its old slot) already had.
-template <class Real>
+/// Positions in Coord, histories in Real.
+template <class Coord, class Real>
 struct fill_entries {
-    neighbour_scan<Real> scan;
+    neighbour_scan<Coord> scan;
     const unsigned* offset;
     unsigned* partner;
     unsigned* key; ///< scratch: each entry's sort key
@@ -221,9 +223,14 @@ private:
 };
 } // namespace detail
 
-template <class Real, class Policy>
+/// The contact lists of particles in precision P (core/precision.cuh): the neighbour search in
+/// coord_t<P> (the positions' type), histories and forces in real_t<P>; host tables in coord_t<P>.
+template <class P, class Policy>
 class contact_lists {
 public:
+    using Real = real_t<P>;
+    using Coord = coord_t<P>;
+
     contact_lists() = default;
     /// Empty lists for n particles; `record_forces` keeps each entry's force of the last step.
     contact_lists(std::size_t n, bool record_forces)
@@ -239,12 +246,12 @@ public:
     /// Rebuilds every list from a grid built over the particles before their permutation into
     /// the grid's order (`user` is the user index of each slot before it): the new lists are
     /// in the new order, or in the old one with `keep_order`. Walls within r + skin are listed too.
-    void rebuild(const grid_view<Real>& grid, const wall_set<Real>& walls, Real skin, const unsigned* user,
+    void rebuild(const grid_view<Coord>& grid, const wall_set<Coord>& walls, Coord skin, const unsigned* user,
                  bool keep_order = false)
     {
         const std::size_t n = size();
-        const detail::neighbour_scan<Real> scan{grid, walls, skin, user, keep_order};
-        for_each_index(Policy{}, n, detail::count_entries<Real>{scan, new_offset_.data()});
+        const detail::neighbour_scan<Coord> scan{grid, walls, skin, user, keep_order};
+        for_each_index(Policy{}, n, detail::count_entries<Coord>{scan, new_offset_.data()});
         const std::size_t total = exclusive_scan_in_place(Policy{}, new_offset_.data(), n + 1);
         if (total >= std::size_t(std::numeric_limits<unsigned>::max()))
             detail::fail("contact lists: ", total, " entries within r_i + r_j + skin, more than 2^32 - 1; reduce the skin");
@@ -252,7 +259,7 @@ public:
             if (b->size() < total) b->resize(total);
         if (new_history_.size() < total) new_history_.resize(total);
         for_each_index(Policy{}, n,
-                       detail::fill_entries<Real>{scan, new_offset_.data(), new_partner_.data(), key_.data(),
+                       detail::fill_entries<Coord, Real>{scan, new_offset_.data(), new_partner_.data(), key_.data(),
                                                   new_history_.data(), offset_.data(), partner_.data(),
                                                   history_.data()});
         offset_.swap(new_offset_);
@@ -268,7 +275,7 @@ public:
     }
 
     /// A host copy in user order; `user` is the user index of each storage slot.
-    contact_table<Real> table(const std::vector<unsigned>& user) const
+    contact_table<Coord> table(const std::vector<unsigned>& user) const
     {
         const std::size_t n = size();
         const std::vector<unsigned> off = offset_.to_host(), part = partner_.to_host();
@@ -277,7 +284,7 @@ public:
         if (record_forces_) frc = force_.to_host();
         std::vector<std::size_t> slot_of(n);
         for (std::size_t k = 0; k < n; ++k) slot_of[user[k]] = k;
-        contact_table<Real> t;
+        contact_table<Coord> t;
         t.offset.assign(n + 1, 0);
         for (std::size_t i = 0; i < n; ++i) t.offset[i + 1] = t.offset[i] + (off[slot_of[i] + 1] - off[slot_of[i]]);
         t.partner.resize(t.offset[n]);
@@ -287,8 +294,8 @@ public:
             std::size_t e = t.offset[i];
             for (unsigned s = off[slot_of[i]]; s < off[slot_of[i] + 1]; ++s, ++e) {
                 t.partner[e] = part[s] >= wall_partner_base ? part[s] : user[part[s]];
-                t.history[e] = hist[s];
-                if (record_forces_) t.force[e] = frc[s];
+                t.history[e] = widen(hist[s]);
+                if (record_forces_) t.force[e] = widen(frc[s]);
             }
         }
         return t;
@@ -296,7 +303,7 @@ public:
 
     /// Replaces the lists and their history by a table in user order (for restarts); `user`
     /// is the user index of each storage slot. Throws when the table does not fit.
-    void restore(const contact_table<Real>& t, const std::vector<unsigned>& user)
+    void restore(const contact_table<Coord>& t, const std::vector<unsigned>& user)
     {
         const std::size_t n = size();
         if (t.particles() != n || t.partner.size() != t.offset[n] || t.history.size() != t.partner.size())
@@ -314,7 +321,8 @@ public:
                 if (j >= wall_partner_base + unsigned(wall_set<Real>::count))
                     detail::fail("contact lists: particle ", i, " lists wall code ", j, ", not a wall face");
                 part.push_back(j >= wall_partner_base ? j : slot_of[j]);
-                hist.push_back(t.history[e]);
+                const vec4<Coord>& h = t.history[e];
+                hist.push_back({Real(h.x), Real(h.y), Real(h.z), Real(h.w)});
             }
             off[k + 1] = static_cast<unsigned>(part.size());
         }
@@ -326,6 +334,8 @@ public:
     }
 
 private:
+    static vec4<Coord> widen(const vec4<Real>& a) { return {Coord(a.x), Coord(a.y), Coord(a.z), Coord(a.w)}; }
+
     bool record_forces_ = true;
     std::size_t entries_ = 0;
     buffer<unsigned, Policy> offset_, partner_;

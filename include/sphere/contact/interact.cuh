@@ -12,7 +12,9 @@
 /// settings. A third, `OneVelocity`, says that the dashpots' velocities are the ones that moved
 /// the positions (velocity Verlet): the step's displacement is then the contact velocity times
 /// dt, and v, omega are not read a second time.
+#include <cmath>
 #include <cstddef>
+#include <type_traits>
 
 #include "../boundary/walls.cuh"
 #include "../boundary/world.cuh"
@@ -36,14 +38,36 @@ struct wall_loads {
     }
 };
 
+/// The normal overlap-distance delta_n = |d| - reach (m, negative in contact) from a
+/// separation d, its squared length dist2 and the sum of radii, and the unit normal d / |d|.
+/// When positions are held in a wider type than the contact law's (precision mixed), the
+/// difference dist2 - reach^2 is formed in that type and divided by |d| + reach in the narrow
+/// one: the overlap keeps its relative precision although |d| and reach agree to 1e-5.
+template <class Real, class Coord>
+SPHERE_HDI Real overlap_and_normal(const vec3<Coord>& d, Coord dist2, Coord reach, vec3<Real>& n)
+{
+    if constexpr (std::is_same_v<Real, Coord>) {
+        const Real dist = std::sqrt(dist2);
+        n = d * (Real(1) / dist);
+        return dist - reach;
+    } else {
+        const Real dist = std::sqrt(Real(dist2));
+        n = vec_cast<Real>(d) * (Real(1) / dist);
+        return Real(dist2 - reach * reach) / (dist + Real(reach));
+    }
+}
+
 /// Particle i's contacts: writes its force and torque (and what Book and Record ask for) and
-/// returns its share of the wall loads.
-template <class Real, class Law, bool Book, bool Record, bool OneVelocity>
+/// returns its share of the wall loads. P is the precision policy: positions, the world and
+/// the walls in coord_t<P>, everything the contact law sees in real_t<P>.
+template <class P, class Law, bool Book, bool Record, bool OneVelocity>
 struct interact {
-    particle_view<Real> p;
+    using Real = real_t<P>;
+    using Coord = coord_t<P>;
+    particle_view<P> p;
     contact_view<Real> c;
-    world<Real> box;
-    wall_set<Real> walls;
+    world<Coord> box;
+    wall_set<Coord> walls;
     contact_params<Real> pair_params;
     contact_params<Real> wall_params;
     Real dt;
@@ -52,7 +76,8 @@ struct interact {
     SPHERE_HD wall_loads operator()(std::size_t i) const
     {
         wall_loads loads{{0, 0, 0, 0, 0, 0}};
-        const vec4<Real> xi = p.x[i];
+        const vec4<Coord> xi = p.x[i];
+        const Real ri = Real(xi.w);
         const vec3<Real> vi = p.v_sync[i], wi = p.omega_sync[i];
         // the last step's motion (unused with OneVelocity)
         const vec3<Real> si = OneVelocity ? vec3<Real>{0, 0, 0} : p.v[i] * dt;
@@ -70,16 +95,14 @@ struct interact {
             vec3<Real> n;
             bool touching;
             if (j < wall_partner_base) {
-                const vec4<Real> xj = p.x[j];
-                const vec3<Real> d = box.nearest_image_inside(xi.xyz() - xj.xyz());
-                const Real dist2 = norm2(d), reach = xi.w + xj.w;
-                touching = dist2 < reach * reach && dist2 > Real(0);
+                const vec4<Coord> xj = p.x[j];
+                const vec3<Coord> d = box.nearest_image_inside(xi.xyz() - xj.xyz());
+                const Coord dist2 = norm2(d), reach = xi.w + xj.w;
+                touching = dist2 < reach * reach && dist2 > Coord(0);
                 if (touching) {
-                    const Real dist = std::sqrt(dist2);
-                    const Real delta_n = dist - reach;
-                    n = d * (Real(1) / dist);
-                    arm = xi.w + delta_n / 2;
-                    const Real arm_j = xj.w + delta_n / 2;
+                    const Real delta_n = overlap_and_normal(d, dist2, reach, n);
+                    arm = ri + delta_n / 2;
+                    const Real arm_j = Real(xj.w) + delta_n / 2;
                     const Real mj = p.mass[j];
                     contact_motion<Real> m;
                     m.n = n;
@@ -94,11 +117,11 @@ struct interact {
                 }
             } else {
                 const int f = static_cast<int>(j - wall_partner_base);
-                const wall_face<Real>& wall = walls.face[f];
+                const wall_face<Coord>& wall = walls.face[f];
                 const int a = f / 2;
                 n = wall_set<Real>::inward_normal(f);
-                const Real dist = (xi.xyz()[a] - Real(wall.position)) * n[a];
-                const Real delta_n = dist - xi.w;
+                const Coord dist_c = (xi.xyz()[a] - Coord(wall.position)) * Coord(n[a]);
+                const Real dist = Real(dist_c), delta_n = Real(dist_c - xi.w);
                 touching = delta_n < Real(0);
                 if (touching) {
                     arm = dist;
@@ -131,7 +154,7 @@ struct interact {
         p.force[i] = force;
         p.torque[i] = torque;
         if (Book && update_history) {
-            p.pressure[i] = fn_sum / (4 * pi<Real> * xi.w * xi.w);
+            p.pressure[i] = fn_sum / (4 * pi<Real> * ri * ri);
             p.p_visc[i] = visc;
             p.p_fric[i] = fric;
             p.e_visc[i] += visc * dt;

@@ -26,4 +26,12 @@ struct contact_params {
     damping_convention damping = damping_convention::absolute; ///< units of gamma_n and gamma_t
 };
 
+/// The same parameters in another precision (the user's double values for a contact law that
+/// computes in float, precision mixed).
+template <class To, class From>
+contact_params<To> params_cast(const contact_params<From>& p)
+{
+    return {To(p.k_n), To(p.k_t), To(p.gamma_n), To(p.gamma_t), To(p.mu_s), To(p.mu_d), p.tension, p.damping};
+}
+
 } // namespace sphere

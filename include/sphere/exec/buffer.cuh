@@ -21,6 +21,7 @@ class buffer;
 template <class T>
 class buffer<T, host> {
 public:
+    using value_type = T;
     buffer() = default;
     explicit buffer(std::size_t n, const T& value = T{}) : data_(n, value) {}
 
@@ -41,6 +42,7 @@ private:
 template <class T>
 class buffer<T, cuda> {
 public:
+    using value_type = T;
     buffer() = default;
     explicit buffer(std::size_t n, const T& value = T{}) : data_(n, value) {}
 

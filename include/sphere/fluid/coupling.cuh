@@ -19,6 +19,7 @@
 /// The forces are explicit: dt_f must not exceed the shortest particle response time
 /// m_i / (beta_per_solid V_i) (checked; the step throws naming the particle).
 #include <cstddef>
+#include <type_traits>
 
 #include "../boundary/world.cuh"
 #include "../core/constants.cuh"
@@ -143,6 +144,9 @@ public:
     template <class Simulation>
     void step(Simulation& sim)
     {
+        static_assert(std::is_same_v<typename Simulation::precision_type, Real>,
+                      "fluid_coupling<Real> couples a simulation<Real> (float or double); precision mixed is not "
+                      "coupled to the pore fluid yet (docs/fluid.md)");
         const Real dt = Real(options_.dem_steps) * sim.dt();
         const particle_view<Real> p = sim.particle_data();
         porosity_.update(p, dt);

@@ -3,6 +3,7 @@
 /// The uniform neighbour grid: hash each particle to its cell, sort by cell (stable),
 /// gather positions in cell order and find where each cell starts in the sorted order.
 #include <cstddef>
+#include <type_traits>
 
 #include "../core/vec.cuh"
 #include "../exec/algorithms.cuh"
@@ -67,9 +68,12 @@ public:
 
     const grid_geometry<Real>& geometry() const { return geometry_; }
 
-    /// Rebuilds the cell lists from the particles' current positions.
-    void build(const particle_view<Real>& p)
+    /// Rebuilds the cell lists from the particles' current positions (held in Real: a grid
+    /// is laid in the type of the positions, coord_t of the particles' precision P).
+    template <class P>
+    void build(const particle_view<P>& p)
     {
+        static_assert(std::is_same_v<coord_t<P>, Real>, "the grid is laid in the type of the positions");
         const std::size_t cells = geometry_.cell_count();
         if (key_.size() != p.n) {
             key_.resize(p.n);

@@ -15,11 +15,11 @@ namespace detail {
 /// The accelerations of free particle i (m/s^2, rad/s^2) under its contact force, external
 /// force (when `external` is not null: the pore fluid's), torque (moment of inertia 2/5 m r^2)
 /// and gravity.
-template <class Real>
-SPHERE_HD void free_accelerations(const particle_view<Real>& p, std::size_t i, const vec3<Real>& gravity,
+template <class P, class Real = real_t<P>>
+SPHERE_HD void free_accelerations(const particle_view<P>& p, std::size_t i, const vec3<Real>& gravity,
                                   const vec3<Real>* external, vec3<Real>& a, vec3<Real>& alpha)
 {
-    const Real m = p.mass[i], r = p.x[i].w;
+    const Real m = p.mass[i], r = Real(p.x[i].w);
     const vec3<Real> f = external ? p.force[i] + external[i] : p.force[i];
     a = f / m + gravity;
     alpha = p.torque[i] / (Real(0.4) * m * r * r);
@@ -31,10 +31,12 @@ SPHERE_HD void free_accelerations(const particle_view<Real>& p, std::size_t i, c
 /// stores the velocities at the new positions' time. Coordinates on periodic axes are wrapped
 /// back into the box. For an integrator that drifts before the forces, the drift has moved
 /// the particles already (drift_particles) and this is its second half kick.
-template <class Real, class Integrator>
+template <class P, class Integrator>
 struct integrate_particles {
-    particle_view<Real> p;
-    world<Real> box;
+    using Real = real_t<P>;
+    using Coord = coord_t<P>;
+    particle_view<P> p;
+    world<Coord> box;
     vec3<Real> gravity;
     Real dt;
     const vec3<Real>* external; ///< external force on each particle (N), or null
@@ -43,8 +45,8 @@ struct integrate_particles {
     {
         const auto kind = static_cast<motion>(p.kind[i]);
         if (kind == motion::fixed) return;
-        vec4<Real> x = p.x[i];
-        vec3<Real> pos = x.xyz();
+        const vec4<Coord> x = p.x[i];
+        vec3<Coord> pos = x.xyz();
         vec3<Real> v = p.v[i], w = p.omega[i], ang = p.angpos[i];
         vec3<Real> v_sync = v, w_sync = w;
         constexpr bool drifted = Integrator::drifts_before_forces;
@@ -61,7 +63,7 @@ struct integrate_particles {
             v_sync = Integrator::synchronous_velocity(v, a, dt);
             if (!drifted) ang += w * dt;
         } else if (!drifted) {
-            pos += v * dt;
+            pos += vec_cast<Coord>(v * dt);
             ang += w * dt;
         }
         if (!drifted) {
@@ -79,10 +81,12 @@ struct integrate_particles {
 /// with the forces of the last step, and its drift): free and horizontally prescribed
 /// particles by Integrator::drift, prescribed ones at their own velocities. The dashpots of
 /// the next force evaluation see the velocities between the kicks.
-template <class Real, class Integrator>
+template <class P, class Integrator>
 struct drift_particles {
-    particle_view<Real> p;
-    world<Real> box;
+    using Real = real_t<P>;
+    using Coord = coord_t<P>;
+    particle_view<P> p;
+    world<Coord> box;
     vec3<Real> gravity;
     Real dt;
     const vec3<Real>* external; ///< external force on each particle (N), or null
@@ -91,8 +95,8 @@ struct drift_particles {
     {
         const auto kind = static_cast<motion>(p.kind[i]);
         if (kind == motion::fixed) return;
-        vec4<Real> x = p.x[i];
-        vec3<Real> pos = x.xyz();
+        const vec4<Coord> x = p.x[i];
+        vec3<Coord> pos = x.xyz();
         vec3<Real> v = p.v[i], w = p.omega[i], ang = p.angpos[i];
         if (kind == motion::free) {
             vec3<Real> a, alpha;
@@ -103,7 +107,7 @@ struct drift_particles {
             Integrator::drift(pos, v, vec3<Real>{0, 0, p.force[i].z / p.mass[i]}, dt);
             ang += w * dt;
         } else {
-            pos += v * dt;
+            pos += vec_cast<Coord>(v * dt);
             ang += w * dt;
         }
         p.x[i] = {box.wrap(pos.x, 0), box.wrap(pos.y, 1), box.wrap(pos.z, 2), x.w};
@@ -133,22 +137,36 @@ struct combine_checks {
     }
 };
 
-template <class Real>
+template <class P>
 struct check_particle {
-    particle_view<Real> p;
-    const vec4<Real>* x_at_build;
-    world<Real> box;
-    wall_set<Real> walls;
+    using Coord = coord_t<P>;
+    particle_view<P> p;
+    const vec4<Coord>* x_at_build;
+    world<Coord> box;
+    wall_set<Coord> walls;
 
-    SPHERE_HD step_check<Real> operator()(std::size_t i) const
+    SPHERE_HD step_check<Coord> operator()(std::size_t i) const
     {
-        const vec3<Real> pos = p.x[i].xyz();
+        const vec3<Coord> pos = p.x[i].xyz();
         bool bad = !isfinite(pos) || !isfinite(p.v_sync[i]) || !isfinite(p.omega_sync[i]);
         for (int a = 0; a < 3; ++a)
-            if (!box.periodic(a) && !(pos[a] >= Real(walls.face[2 * a].position) && pos[a] <= Real(walls.face[2 * a + 1].position)))
+            if (!box.periodic(a) && !(pos[a] >= Coord(walls.face[2 * a].position) && pos[a] <= Coord(walls.face[2 * a + 1].position)))
                 bad = true;
-        const Real moved = norm2(box.nearest_image(pos - x_at_build[i].xyz()));
-        return {bad ? Real(0) : moved, bad ? std::size_t(p.user[i]) : ~std::size_t(0)};
+        const Coord moved = norm2(box.nearest_image(pos - x_at_build[i].xyz()));
+        return {bad ? Coord(0) : moved, bad ? std::size_t(p.user[i]) : ~std::size_t(0)};
+    }
+};
+
+/// Runs a particle kernel `body` on particle i, then checks the particle (kernel body of a
+/// transform_reduce: one parallel pass instead of two).
+template <class Body, class P>
+struct then_check {
+    Body body;
+    check_particle<P> check;
+    SPHERE_HD step_check<coord_t<P>> operator()(std::size_t i) const
+    {
+        body(i);
+        return check(i);
     }
 };
 

@@ -9,6 +9,9 @@
 /// An integrator with `drifts_before_forces` (velocity Verlet) splits the step around the
 /// force evaluation: `drift` before it (with the acceleration of the last forces), `advance`
 /// after it. The others do all of their step in `advance`, after the forces.
+///
+/// Positions may be held in a wider type (Coord) than velocities (Real, precision mixed): the
+/// step's displacement is formed in Real and added to the position in Coord.
 #include "../core/vec.cuh"
 
 namespace sphere {
@@ -18,11 +21,11 @@ namespace integrate {
 /// energy of an elastic collision (e = 1.000 +- 0.001 at dt = 0.075 sqrt(m / k_n)).
 struct semi_implicit_euler {
     static constexpr bool drifts_before_forces = false;
-    template <class Real>
-    SPHERE_HD static void advance(vec3<Real>& x, vec3<Real>& v, const vec3<Real>& a, Real dt)
+    template <class Coord, class Real>
+    SPHERE_HD static void advance(vec3<Coord>& x, vec3<Real>& v, const vec3<Real>& a, Real dt)
     {
         v += a * dt;
-        x += v * dt;
+        x += vec_cast<Coord>(v * dt);
     }
 
     /// v is the mid-step velocity v(t + dt/2); the velocity at the new position's time is
@@ -38,10 +41,10 @@ struct semi_implicit_euler {
 /// collisions (e = 1.087 for an elastic pair at the default time step).
 struct taylor2 {
     static constexpr bool drifts_before_forces = false;
-    template <class Real>
-    SPHERE_HD static void advance(vec3<Real>& x, vec3<Real>& v, const vec3<Real>& a, Real dt)
+    template <class Coord, class Real>
+    SPHERE_HD static void advance(vec3<Coord>& x, vec3<Real>& v, const vec3<Real>& a, Real dt)
     {
-        x += v * dt + a * (dt * dt / 2);
+        x += vec_cast<Coord>(v * dt + a * (dt * dt / 2));
         v += a * dt;
     }
 
@@ -56,10 +59,10 @@ struct taylor2 {
 /// pair at the default time step).
 struct explicit_euler {
     static constexpr bool drifts_before_forces = false;
-    template <class Real>
-    SPHERE_HD static void advance(vec3<Real>& x, vec3<Real>& v, const vec3<Real>& a, Real dt)
+    template <class Coord, class Real>
+    SPHERE_HD static void advance(vec3<Coord>& x, vec3<Real>& v, const vec3<Real>& a, Real dt)
     {
-        x += v * dt;
+        x += vec_cast<Coord>(v * dt);
         v += a * dt;
     }
 
@@ -78,15 +81,15 @@ struct explicit_euler {
 struct velocity_verlet {
     static constexpr bool drifts_before_forces = true;
 
-    template <class Real>
-    SPHERE_HD static void drift(vec3<Real>& x, vec3<Real>& v, const vec3<Real>& a, Real dt)
+    template <class Coord, class Real>
+    SPHERE_HD static void drift(vec3<Coord>& x, vec3<Real>& v, const vec3<Real>& a, Real dt)
     {
         v += a * (dt / 2);
-        x += v * dt;
+        x += vec_cast<Coord>(v * dt);
     }
 
-    template <class Real>
-    SPHERE_HD static void advance(vec3<Real>&, vec3<Real>& v, const vec3<Real>& a, Real dt)
+    template <class Coord, class Real>
+    SPHERE_HD static void advance(vec3<Coord>&, vec3<Real>& v, const vec3<Real>& a, Real dt)
     {
         v += a * (dt / 2);
     }

@@ -6,9 +6,11 @@
 /// the particle in storage slot k. Snapshots and restores speak in user indices.
 #include <cstddef>
 #include <cstdint>
+#include <type_traits>
 #include <vector>
 
 #include "../core/constants.cuh"
+#include "../core/precision.cuh"
 #include "../core/vec.cuh"
 #include "../exec/buffer.cuh"
 #include "../exec/for_each.cuh"
@@ -17,10 +19,14 @@
 namespace sphere {
 
 /// Raw pointers to every per-particle field; trivially copyable, handed to kernels by value.
-template <class Real>
+/// P is a precision policy (core/precision.cuh): positions and radii in coord_t<P>, the rest
+/// in real_t<P>.
+template <class P>
 struct particle_view {
+    using Real = real_t<P>;
+    using Coord = coord_t<P>;
     std::size_t n;
-    vec4<Real>* x;          ///< position (m) in xyz, radius (m) in w
+    vec4<Coord>* x;         ///< position (m) in xyz, radius (m) in w
     vec3<Real>* v;          ///< velocity (m/s)
     vec3<Real>* omega;      ///< angular velocity (rad/s)
     vec3<Real>* v_sync;     ///< velocity at the time of the positions (m/s), seen by contact laws
@@ -41,10 +47,10 @@ struct particle_view {
 namespace detail {
 /// Copies particle i's position and radius (kernel body): positions at a reference time, for
 /// displacements since then.
-template <class Real>
+template <class Coord>
 struct copy_positions {
-    const vec4<Real>* from;
-    vec4<Real>* to;
+    const vec4<Coord>* from;
+    vec4<Coord>* to;
     SPHERE_HD void operator()(std::size_t i) const { to[i] = from[i]; }
 };
 
@@ -65,7 +71,8 @@ struct copy_back {
 };
 } // namespace detail
 
-/// A host copy of every per-particle field, in the user's particle order.
+/// A host copy of every per-particle field, in the user's particle order, in the simulation's
+/// user-facing type (coord_t of its precision).
 template <class Real>
 struct particle_snapshot {
     std::vector<vec4<Real>> x;
@@ -78,23 +85,27 @@ struct particle_snapshot {
     Real radius(std::size_t i) const { return x[i].w; }
 };
 
-/// The owning particle arrays.
-template <class Real, class Policy>
+/// The owning particle arrays, in precision P (core/precision.cuh); snapshots and particle
+/// descriptions are in coord_t<P>.
+template <class P, class Policy>
 class particle_state {
 public:
+    using Real = real_t<P>;
+    using Coord = coord_t<P>;
+
     particle_state() = default;
 
     /// Fills the arrays from validated particle descriptions.
-    explicit particle_state(const std::vector<particle<Real>>& particles)
+    explicit particle_state(const std::vector<particle<Coord>>& particles)
     {
-        particle_snapshot<Real> s;
+        particle_snapshot<Coord> s;
         const std::size_t n = particles.size();
         s.x.resize(n);
         s.v.resize(n);
         s.omega.resize(n);
-        s.angpos.assign(n, vec3<Real>{0, 0, 0});
-        s.force.assign(n, vec3<Real>{0, 0, 0});
-        s.torque.assign(n, vec3<Real>{0, 0, 0});
+        s.angpos.assign(n, vec3<Coord>{0, 0, 0});
+        s.force.assign(n, vec3<Coord>{0, 0, 0});
+        s.torque.assign(n, vec3<Coord>{0, 0, 0});
         s.mass.resize(n);
         s.pressure.assign(n, 0);
         s.e_visc.assign(n, 0);
@@ -103,12 +114,14 @@ public:
         s.p_fric.assign(n, 0);
         s.kind.resize(n);
         for (std::size_t i = 0; i < n; ++i) {
-            const particle<Real>& p = particles[i];
+            const particle<Coord>& p = particles[i];
             s.x[i] = {p.position.x, p.position.y, p.position.z, p.radius};
             const bool still = p.kind == motion::fixed;
-            s.v[i] = still ? vec3<Real>{0, 0, 0} : p.velocity;
-            s.omega[i] = still ? vec3<Real>{0, 0, 0} : p.angular_velocity;
-            s.mass[i] = sphere_mass(p.radius, p.density);
+            // velocities and masses are held in Real: round them here, so that a snapshot
+            // shows what the arrays hold
+            s.v[i] = still ? vec3<Coord>{0, 0, 0} : vec_cast<Coord>(vec_cast<Real>(p.velocity));
+            s.omega[i] = still ? vec3<Coord>{0, 0, 0} : vec_cast<Coord>(vec_cast<Real>(p.angular_velocity));
+            s.mass[i] = Coord(Real(sphere_mass(p.radius, p.density)));
             s.kind[i] = static_cast<std::uint8_t>(p.kind);
         }
         s.v_sync = s.v;
@@ -121,7 +134,7 @@ public:
 
     std::size_t size() const { return x_.size(); }
 
-    particle_view<Real> view()
+    particle_view<P> view()
     {
         return {x_.size(),       x_.data(),      v_.data(),      omega_.data(),  v_sync_.data(),
                 omega_sync_.data(),                                               angpos_.data(),
@@ -154,13 +167,13 @@ public:
     }
 
     /// A host copy of every field, in user order.
-    particle_snapshot<Real> snapshot() const
+    particle_snapshot<Coord> snapshot() const
     {
         const std::vector<unsigned> user = user_.to_host();
         auto out = [&](const auto& field) {
-            auto slots = field.to_host();
-            auto users = slots;
-            for (std::size_t k = 0; k < slots.size(); ++k) users[user[k]] = slots[k];
+            const auto slots = field.to_host();
+            std::vector<decltype(widen(slots[0]))> users(slots.size());
+            for (std::size_t k = 0; k < slots.size(); ++k) users[user[k]] = widen(slots[k]);
             return users;
         };
         return {out(x_),     out(v_),      out(omega_),  out(v_sync_), out(omega_sync_),
@@ -170,12 +183,13 @@ public:
 
     /// Replaces every field by a snapshot's, given in user order (for restarts and for
     /// host-side edits); the storage order stays.
-    void restore(const particle_snapshot<Real>& s)
+    void restore(const particle_snapshot<Coord>& s)
     {
         const std::vector<unsigned> user = user_.to_host();
         auto in = [&](auto& field, const auto& users) {
-            auto slots = users;
-            for (std::size_t k = 0; k < slots.size(); ++k) slots[k] = users[user[k]];
+            using T = typename std::remove_reference_t<decltype(field)>::value_type;
+            std::vector<T> slots(users.size());
+            for (std::size_t k = 0; k < slots.size(); ++k) slots[k] = narrow<T>(users[user[k]]);
             field.assign(slots);
         };
         in(x_, s.x);
@@ -196,6 +210,16 @@ public:
     }
 
 private:
+    /// A stored value in the snapshot's type, and back (identity unless P is mixed).
+    static vec4<Coord> widen(const vec4<Coord>& a) { return a; }
+    static vec3<Coord> widen(const vec3<Real>& a) { return vec_cast<Coord>(a); }
+    static Coord widen(Real a) { return Coord(a); }
+    static std::uint8_t widen(std::uint8_t a) { return a; }
+    template <class T> static T narrow(const vec4<Coord>& a) { return a; }
+    template <class T> static T narrow(const vec3<Coord>& a) { return vec_cast<Real>(a); }
+    template <class T> static T narrow(Coord a) { return T(a); }
+    template <class T> static T narrow(std::uint8_t a) { return a; }
+
     template <class F>
     void each_field(F f)
     {
@@ -207,19 +231,19 @@ private:
     template <class T>
     void permute_field(buffer<T, Policy>& field, const unsigned* order)
     {
-        static_assert(sizeof(T) <= sizeof(vec4<Real>) && alignof(T) <= alignof(vec4<Real>), "scratch too narrow");
+        static_assert(sizeof(T) <= sizeof(vec4<Coord>) && alignof(T) <= alignof(vec4<Coord>), "scratch too narrow");
         T* tmp = reinterpret_cast<T*>(scratch_.data());
         const std::size_t n = field.size();
         for_each_index(Policy{}, n, detail::gather<T>{field.data(), order, tmp});
         for_each_index(Policy{}, n, detail::copy_back<T>{tmp, field.data()});
     }
 
-    buffer<vec4<Real>, Policy> x_;
+    buffer<vec4<Coord>, Policy> x_;
     buffer<vec3<Real>, Policy> v_, omega_, v_sync_, omega_sync_, angpos_, force_, torque_;
     buffer<Real, Policy> mass_, pressure_, e_visc_, e_fric_, p_visc_, p_fric_;
     buffer<std::uint8_t, Policy> kind_;
     buffer<unsigned, Policy> user_;
-    buffer<vec4<Real>, Policy> scratch_; ///< permutation scratch, one element per particle
+    buffer<vec4<Coord>, Policy> scratch_; ///< permutation scratch, one element per particle
 };
 
 } // namespace sphere
