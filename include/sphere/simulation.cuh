@@ -147,7 +147,7 @@ public:
         }
         dt_ = Coord(Real(dt_)); // the kernels step velocities with dt in Real: one dt throughout
 
-        particles_ = particle_state<Precision, Policy>(particles);
+        particles_ = particle_state<Precision, Policy>(particles, Integrator::distinct_synchronous_velocity);
         for (const particle<Coord>& p : particles) {
             kinds_.push_back(p.kind);
             if (p.kind == motion::prescribed || p.kind == motion::prescribed_horizontal) drive_ = true;
@@ -395,8 +395,9 @@ private:
         const grid_view<Coord> g = grid_.view();
         lists_.rebuild(g, walls_, settings_.skin, particles_.view().user, !settings_.reorder);
         if (settings_.reorder) {
-            particles_.permute(g.order);
-            if (external_.size()) particles_.permute_along(external_, g.order);
+            vec4<Coord>* scratch = grid_.reusable_positions(); // the lists are built: free to reuse
+            particles_.permute(g.order, scratch);
+            if (external_.size()) particles_.permute_along(external_, g.order, scratch);
         }
         const particle_view<Precision> p = particles_.view();
         for_each_index(Policy{}, p.n, detail::copy_positions<Coord>{p.x, x_at_build_.data()});

@@ -88,6 +88,11 @@ public:
                                                       cell_start_.data()});
     }
 
+    /// The storage of the sorted positions, for a caller that no longer needs them until the
+    /// next build: the simulation permutes the particles through it once the contact lists are
+    /// built (one array fewer per particle). Invalidates view().sorted_x.
+    vec4<Real>* reusable_positions() { return sorted_x_.data(); }
+
     grid_view<Real> view() const
     {
         return {geometry_, key_.size(), order_.data(), sorted_x_.data(), cell_start_.data()};

@@ -6,6 +6,9 @@
 /// laws and diagnostics use that one). Errors at the default time step: docs/physics.md,
 /// "Integration".
 ///
+/// `distinct_synchronous_velocity` says whether synchronous_velocity can differ from v: when it
+/// cannot, the particles keep one velocity array instead of two.
+///
 /// An integrator with `drifts_before_forces` (velocity Verlet) splits the step around the
 /// force evaluation: `drift` before it (with the acceleration of the last forces), `advance`
 /// after it. The others do all of their step in `advance`, after the forces.
@@ -21,6 +24,8 @@ namespace integrate {
 /// energy of an elastic collision (e = 1.000 +- 0.001 at dt = 0.075 sqrt(m / k_n)).
 struct semi_implicit_euler {
     static constexpr bool drifts_before_forces = false;
+    /// the velocity at the positions' time differs from v (and is stored apart, v_sync)
+    static constexpr bool distinct_synchronous_velocity = true;
     template <class Coord, class Real>
     SPHERE_HD static void advance(vec3<Coord>& x, vec3<Real>& v, const vec3<Real>& a, Real dt)
     {
@@ -41,6 +46,7 @@ struct semi_implicit_euler {
 /// collisions (e = 1.087 for an elastic pair at the default time step).
 struct taylor2 {
     static constexpr bool drifts_before_forces = false;
+    static constexpr bool distinct_synchronous_velocity = false;
     template <class Coord, class Real>
     SPHERE_HD static void advance(vec3<Coord>& x, vec3<Real>& v, const vec3<Real>& a, Real dt)
     {
@@ -59,6 +65,7 @@ struct taylor2 {
 /// pair at the default time step).
 struct explicit_euler {
     static constexpr bool drifts_before_forces = false;
+    static constexpr bool distinct_synchronous_velocity = false;
     template <class Coord, class Real>
     SPHERE_HD static void advance(vec3<Coord>& x, vec3<Real>& v, const vec3<Real>& a, Real dt)
     {
@@ -80,6 +87,7 @@ struct explicit_euler {
 /// the positions.
 struct velocity_verlet {
     static constexpr bool drifts_before_forces = true;
+    static constexpr bool distinct_synchronous_velocity = false;
 
     template <class Coord, class Real>
     SPHERE_HD static void drift(vec3<Coord>& x, vec3<Real>& v, const vec3<Real>& a, Real dt)

@@ -95,8 +95,11 @@ public:
 
     particle_state() = default;
 
-    /// Fills the arrays from validated particle descriptions.
-    explicit particle_state(const std::vector<particle<Coord>>& particles)
+    /// Fills the arrays from validated particle descriptions. Without `distinct_sync` the
+    /// velocities at the positions' time are the velocities themselves (every integrator but
+    /// semi-implicit Euler): v_sync and omega_sync then share v's and omega's arrays.
+    explicit particle_state(const std::vector<particle<Coord>>& particles, bool distinct_sync = true)
+        : distinct_sync_(distinct_sync)
     {
         particle_snapshot<Coord> s;
         const std::size_t n = particles.size();
@@ -136,8 +139,10 @@ public:
 
     particle_view<P> view()
     {
-        return {x_.size(),       x_.data(),      v_.data(),      omega_.data(),  v_sync_.data(),
-                omega_sync_.data(),                                               angpos_.data(),
+        vec3<Real>* v_sync = distinct_sync_ ? v_sync_.data() : v_.data();
+        vec3<Real>* omega_sync = distinct_sync_ ? omega_sync_.data() : omega_.data();
+        return {x_.size(),       x_.data(),      v_.data(),      omega_.data(),  v_sync,
+                omega_sync,                                                      angpos_.data(),
                 force_.data(),   torque_.data(), mass_.data(),   pressure_.data(), e_visc_.data(),
                 e_fric_.data(),  p_visc_.data(), p_fric_.data(), kind_.data(),   user_.data()};
     }
@@ -145,13 +150,13 @@ public:
     /// The user's index of the particle in each storage slot (host copy).
     std::vector<unsigned> user_indices() const { return user_.to_host(); }
 
-    /// Moves the particle in slot order[k] to slot k, for every k (order is a permutation).
-    void permute(const unsigned* order)
+    /// Moves the particle in slot order[k] to slot k, for every k (order is a permutation),
+    /// through `scratch`: size() elements that the caller does not need (the neighbour grid's
+    /// sorted positions once the contact lists are built).
+    void permute(const unsigned* order, vec4<Coord>* scratch)
     {
-        const std::size_t n = size();
-        if (scratch_.size() != n) scratch_.resize(n);
-        each_field([&](auto& field) { permute_field(field, order); });
-        permute_field(user_, order);
+        each_field([&](auto& field) { permute_field(field, order, scratch); });
+        permute_field(user_, order, scratch);
     }
 
     /// Sets which particle each slot holds (user index per slot), e.g. for a restart; the
@@ -161,9 +166,9 @@ public:
     /// Applies the permutation of the last `permute` to another per-particle array that must
     /// stay in step with the particles (e.g. external forces).
     template <class T>
-    void permute_along(buffer<T, Policy>& field, const unsigned* order)
+    void permute_along(buffer<T, Policy>& field, const unsigned* order, vec4<Coord>* scratch)
     {
-        permute_field(field, order);
+        permute_field(field, order, scratch);
     }
 
     /// A host copy of every field, in user order.
@@ -176,7 +181,8 @@ public:
             for (std::size_t k = 0; k < slots.size(); ++k) users[user[k]] = widen(slots[k]);
             return users;
         };
-        return {out(x_),     out(v_),      out(omega_),  out(v_sync_), out(omega_sync_),
+        return {out(x_),     out(v_),      out(omega_),  out(distinct_sync_ ? v_sync_ : v_),
+                out(distinct_sync_ ? omega_sync_ : omega_),
                 out(angpos_), out(force_),  out(torque_), out(mass_),   out(pressure_),
                 out(e_visc_), out(e_fric_), out(p_visc_), out(p_fric_), out(kind_)};
     }
@@ -195,8 +201,10 @@ public:
         in(x_, s.x);
         in(v_, s.v);
         in(omega_, s.omega);
-        in(v_sync_, s.v_sync);
-        in(omega_sync_, s.omega_sync);
+        if (distinct_sync_) {
+            in(v_sync_, s.v_sync);
+            in(omega_sync_, s.omega_sync);
+        }
         in(angpos_, s.angpos);
         in(force_, s.force);
         in(torque_, s.torque);
@@ -229,10 +237,10 @@ private:
 
     /// Gathers one field into the scratch (wide enough for any field) and copies it back.
     template <class T>
-    void permute_field(buffer<T, Policy>& field, const unsigned* order)
+    void permute_field(buffer<T, Policy>& field, const unsigned* order, vec4<Coord>* scratch)
     {
         static_assert(sizeof(T) <= sizeof(vec4<Coord>) && alignof(T) <= alignof(vec4<Coord>), "scratch too narrow");
-        T* tmp = reinterpret_cast<T*>(scratch_.data());
+        T* tmp = reinterpret_cast<T*>(scratch);
         const std::size_t n = field.size();
         for_each_index(Policy{}, n, detail::gather<T>{field.data(), order, tmp});
         for_each_index(Policy{}, n, detail::copy_back<T>{tmp, field.data()});
@@ -243,7 +251,7 @@ private:
     buffer<Real, Policy> mass_, pressure_, e_visc_, e_fric_, p_visc_, p_fric_;
     buffer<std::uint8_t, Policy> kind_;
     buffer<unsigned, Policy> user_;
-    buffer<vec4<Coord>, Policy> scratch_; ///< permutation scratch, one element per particle
+    bool distinct_sync_ = true; ///< v_sync_, omega_sync_ hold their own values (else empty: v_, omega_)
 };
 
 } // namespace sphere
