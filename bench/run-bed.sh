@@ -44,7 +44,7 @@ awk '
         if (match(line, /precision=[a-z]+/)) p = " " substr(line, RSTART + 10, RLENGTH - 10)
         return code p " N=" n " x" t
     }
-    {
+    /particle-steps\/s/ { # the timing lines (sphere also prints a memory line)
         for (i = 1; i <= NF; ++i) if ($i == "particle-steps/s") rate = $(i - 1)
         k = key_of($0); vals[k] = vals[k] " " rate; keys[k] = 1
     }

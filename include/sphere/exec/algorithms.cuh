@@ -68,7 +68,7 @@ T transform_reduce(host, std::size_t n, const Transform& f, T init, Op op)
     const std::size_t chunks = (n + chunk - 1) / chunk;
     std::vector<T> partial(chunks, init);
     const long long count = static_cast<long long>(chunks);
-#pragma omp parallel for schedule(dynamic, 1) if (chunks > 1) // chunks as threads ask (for_each_index)
+#pragma omp parallel for schedule(static) if (chunks > 1)
     for (long long c = 0; c < count; ++c) {
         const std::size_t begin = static_cast<std::size_t>(c) * chunk;
         const std::size_t end = begin + chunk < n ? begin + chunk : n;
