@@ -115,3 +115,45 @@ TEST_CASE("mixed hands out double positions unrounded and float fields exactly",
         CHECK(again.particles.v[i] == st.particles.v[i]);
     }
 }
+
+TEST_CASE("mixed refuses values that float cannot hold, naming them", "[precision][errors]")
+{
+    vec3<double> a, b;
+    const auto ps = skew_pair<double>(a, b);
+    sphere::settings<double> s;
+    s.box.hi = {0.1, 0.1, 0.1};
+    s.contact.k_n = s.contact.k_t = k_n;
+    s.wall = s.contact;
+    using mixed_sim = sphere::simulation<sphere::mixed>;
+    {
+        sphere::settings<double> t = s;
+        t.contact.k_n = 1e39; // a double, but above float's 3.4e38
+        REQUIRE_THROWS_WITH(mixed_sim(t, ps), Catch::Contains("settings.contact.k_n = 9.99999") &&
+                                                  Catch::Contains("e+38 N/m does not fit in float"));
+    }
+    {
+        sphere::settings<double> t = s;
+        t.wall.gamma_n = 1e-50; // rounds to zero in float
+        REQUIRE_THROWS_WITH(mixed_sim(t, ps), Catch::Contains("settings.wall.gamma_n = 1") &&
+                                                  Catch::Contains("e-50 does not fit in float"));
+    }
+    {
+        auto heavy = ps;
+        heavy[1].density = 1e45; // mass 4.2e39 kg: above float's 3.4e38
+        REQUIRE_THROWS_WITH(mixed_sim(s, heavy), Catch::Contains("particle 1: mass (radius 0.01") &&
+                                                     Catch::Contains("kg/m^3) = 4.18") &&
+                                                     Catch::Contains("e+39 kg does not fit in float"));
+    }
+    {
+        auto fast = ps;
+        fast[0].kind = sphere::motion::free;
+        fast[0].velocity = {0, 1e40, 0};
+        REQUIRE_THROWS_WITH(mixed_sim(s, fast), Catch::Contains("particle 0: velocity[1] = 1") &&
+                                                    Catch::Contains("e+40 m/s does not fit in float"));
+    }
+    // the same values are fine in double
+    sphere::settings<double> t = s;
+    t.contact.k_n = t.contact.k_t = 1e39;
+    t.wall = t.contact;
+    CHECK_NOTHROW(sphere::simulation<double>(t, ps));
+}

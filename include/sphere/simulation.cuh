@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cstddef>
 #include <functional>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -125,12 +126,20 @@ public:
         validate_wall_controls(s.walls, s.box);
         if (particles.empty()) detail::fail("no particles: a simulation needs at least one");
         validate_particles(particles, s.box);
+        check_fits_real(s);
 
         Coord min_mass = 0, max_radius = 0;
         for (std::size_t i = 0; i < particles.size(); ++i) {
             particle<Coord>& p = particles[i];
             for (int a = 0; a < 3; ++a) p.position[a] = s.box.wrap(p.position[a], a);
             const Coord m = sphere_mass(p.radius, p.density);
+            if constexpr (!std::is_same_v<Real, Coord>) {
+                fits_real(m, " kg", "particle ", i, ": mass (radius ", p.radius, " m, density ", p.density, " kg/m^3)");
+                for (int a = 0; a < 3; ++a) {
+                    fits_real(p.velocity[a], " m/s", "particle ", i, ": velocity[", a, "]");
+                    fits_real(p.angular_velocity[a], " rad/s", "particle ", i, ": angular_velocity[", a, "]");
+                }
+            }
             min_mass = i == 0 || m < min_mass ? m : min_mass;
             max_radius = p.radius > max_radius ? p.radius : max_radius;
         }
@@ -450,6 +459,35 @@ private:
             if (walls_.face[f].active && std::fabs(walls_.face[f].position - walls_at_build_.face[f].position) + moved > skin)
                 rebuild = true;
         needs_rebuild_ = needs_rebuild_ || rebuild;
+    }
+
+    /// Refuses a value that the particle fields and contact laws cannot hold in Real when Real
+    /// is narrower than the user's type (precision mixed): it overflows float, or a non-zero
+    /// value rounds to zero. `where...` names it.
+    template <class... Where>
+    static void fits_real(Coord value, const char* unit, const Where&... where)
+    {
+        const Real narrowed = Real(value);
+        if (!std::isfinite(narrowed) || (value != Coord(0) && narrowed == Real(0)))
+            detail::fail(where..., " = ", value, unit,
+                         " does not fit in float, the precision of the particle fields and contact laws of "
+                         "sphere::mixed (magnitudes from 1.2e-38 to 3.4e38)");
+    }
+
+    /// fits_real for every contact parameter and gravity (precision mixed).
+    static void check_fits_real(const settings<Coord>& s)
+    {
+        if constexpr (!std::is_same_v<Real, Coord>) {
+            for (const auto& [p, where] : {std::pair{&s.contact, "settings.contact"}, std::pair{&s.wall, "settings.wall"}}) {
+                fits_real(p->k_n, " N/m", where, ".k_n");
+                fits_real(p->k_t, " N/m", where, ".k_t");
+                fits_real(p->gamma_n, "", where, ".gamma_n");
+                fits_real(p->gamma_t, "", where, ".gamma_t");
+                fits_real(p->mu_s, "", where, ".mu_s");
+                fits_real(p->mu_d, "", where, ".mu_d");
+            }
+            for (int a = 0; a < 3; ++a) fits_real(s.gravity[a], " m/s^2", "settings.gravity[", a, "]");
+        }
     }
 
     /// Throws the error for particle i (a user index) at step `step`.
