@@ -294,8 +294,8 @@ public:
             std::size_t e = t.offset[i];
             for (unsigned s = off[slot_of[i]]; s < off[slot_of[i] + 1]; ++s, ++e) {
                 t.partner[e] = part[s] >= wall_partner_base ? part[s] : user[part[s]];
-                t.history[e] = widen(hist[s]);
-                if (record_forces_) t.force[e] = widen(frc[s]);
+                t.history[e] = vec_cast<Coord>(hist[s]);
+                if (record_forces_) t.force[e] = vec_cast<Coord>(frc[s]);
             }
         }
         return t;
@@ -321,8 +321,7 @@ public:
                 if (j >= wall_partner_base + unsigned(wall_set<Real>::count))
                     detail::fail("contact lists: particle ", i, " lists wall code ", j, ", not a wall face");
                 part.push_back(j >= wall_partner_base ? j : slot_of[j]);
-                const vec4<Coord>& h = t.history[e];
-                hist.push_back({Real(h.x), Real(h.y), Real(h.z), Real(h.w)});
+                hist.push_back(vec_cast<Real>(t.history[e]));
             }
             off[k + 1] = static_cast<unsigned>(part.size());
         }
@@ -334,8 +333,6 @@ public:
     }
 
 private:
-    static vec4<Coord> widen(const vec4<Real>& a) { return {Coord(a.x), Coord(a.y), Coord(a.z), Coord(a.w)}; }
-
     bool record_forces_ = true;
     std::size_t entries_ = 0;
     buffer<unsigned, Policy> offset_, partner_;

@@ -59,5 +59,9 @@ template <class To, class From> SPHERE_HDI vec3<To> vec_cast(const vec3<From>& a
 {
     return {static_cast<To>(a.x), static_cast<To>(a.y), static_cast<To>(a.z)};
 }
+template <class To, class From> SPHERE_HDI vec4<To> vec_cast(const vec4<From>& a)
+{
+    return {static_cast<To>(a.x), static_cast<To>(a.y), static_cast<To>(a.z), static_cast<To>(a.w)};
+}
 
 } // namespace sphere
