@@ -18,7 +18,7 @@ if(NOT DEFINED SPHERE_VTK_PYTHON)
 endif()
 
 add_executable(vti_writer_for_test "${CMAKE_CURRENT_LIST_DIR}/vti_writer_main.cpp")
-target_link_libraries(vti_writer_for_test PRIVATE sphere::sphere sphere_warnings)
+target_link_libraries(vti_writer_for_test PRIVATE sphere::sphere sphere_project_flags)
 
 if(EXISTS "${SPHERE_VTK_PYTHON}")
     add_test(NAME fluid_io_vti_read

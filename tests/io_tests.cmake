@@ -6,7 +6,7 @@
 # The test is skipped (exit code 77) only when that interpreter cannot import VTK.
 
 add_executable(vtk_writer_for_test "${CMAKE_CURRENT_LIST_DIR}/vtk_writer_main.cpp")
-target_link_libraries(vtk_writer_for_test PRIVATE sphere::sphere sphere_warnings)
+target_link_libraries(vtk_writer_for_test PRIVATE sphere::sphere sphere_project_flags)
 
 set(SPHERE_VTK_PYTHON "/usr/bin/python3" CACHE FILEPATH
     "Python interpreter that can import VTK (Debian python3-vtk9), for the VTK read-back test")

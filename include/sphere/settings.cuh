@@ -7,6 +7,7 @@
 #include "boundary/walls.cuh"
 #include "boundary/world.cuh"
 #include "contact/params.cuh"
+#include "contact/summation.cuh"
 #include "core/vec.cuh"
 
 namespace sphere {
@@ -30,6 +31,9 @@ struct settings {
     /// false keeps the user's order. Results do not depend on it, except through sums over all
     /// particles (the wall forces, which stress-controlled walls feed back: docs/architecture.md).
     bool reorder = true;
+    /// How pair forces reach the particles (contact/summation.cuh): the default picks the
+    /// backend's fast schedule; both give the same physics to round-off.
+    sphere::pair_summation pair_summation = sphere::pair_summation::automatic;
     Real cell_size = 0;             ///< neighbour-grid cell width (m); 0 selects the largest diameter plus skin
     /// Motion of each wall face f (axis f / 2, lower face when f is even; the upper wall is
     /// walls[5]); all fixed by default.

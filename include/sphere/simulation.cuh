@@ -14,6 +14,7 @@
 #include "boundary/wall_control.cuh"
 #include "boundary/walls.cuh"
 #include "contact/contact_lists.cuh"
+#include "contact/evaluate.cuh"
 #include "contact/interact.cuh"
 #include "contact/linear.cuh"
 #include "core/error.cuh"
@@ -47,6 +48,28 @@ struct drive_power {
         vec3<Real> agent = -(p.force[i] + gravity * p.mass[i]);
         if (kind == motion::prescribed_horizontal) agent.z = -gravity.z * p.mass[i];
         return double(dot(agent, p.v_sync[i])) - double(dot(p.torque[i], p.omega_sync[i]));
+    }
+};
+
+/// A particle kernel run by rank: index r runs `body` on the particle of rank r (the order of
+/// the contact lists, contact/contact_lists.cuh), so that a reduction over it sums in the same
+/// order whatever the storage order.
+template <class Body, class Real>
+struct by_rank {
+    Body body;
+    contact_view<Real> c;
+    SPHERE_HDI auto operator()(std::size_t r) const { return body(c.slot(r)); }
+};
+
+/// Runs two particle kernels on particle i, one after the other.
+template <class First, class Second>
+struct both {
+    First first;
+    Second second;
+    SPHERE_HDI void operator()(std::size_t i) const
+    {
+        first(i);
+        second(i);
     }
 };
 
@@ -164,41 +187,19 @@ public:
         walls_ = wall_set<Coord>::from_world(s.box);
         grid_ = neighbor_grid<Coord, Policy>(grid_geometry<Coord>::make(s.box, 2 * max_radius + s.skin, s.cell_size));
         lists_ = contact_lists<Precision, Policy>(particles.size(), s.contact_forces);
+        summation_ = interaction<Precision, Policy>::resolve(s.pair_summation);
         x_at_build_.resize(particles.size());
         rebuild_lists();
         // An integrator that kicks before the forces needs the forces of the start.
-        if (Integrator::drifts_before_forces) interact(false);
+        if (Integrator::drifts_before_forces)
+            settings_.contact_forces ? initial_forces<true>() : initial_forces<false>();
     }
 
     /// One DEM step of length dt().
     void step()
     {
-        // Views hold raw pointers into arrays that a rebuild permutes in place (their
-        // addresses stay), and external forces are permuted along with the particles.
-        const particle_view<Precision> p = particles_.view();
-        const std::size_t n = p.n;
-        const vec3<Real>* external = external_.size() ? external_.data() : nullptr;
-        const detail::integrate_particles<Precision, Integrator> integrate{p, settings_.box, gravity_, Real(dt_), external};
-        detail::step_check<Coord> check{0, ~std::size_t(0)};
-        // The particle check runs in the same pass as the motion: after the drift (velocity
-        // Verlet) or after the integration.
-        if constexpr (Integrator::drifts_before_forces) {
-            check = checked(detail::drift_particles<Precision, Integrator>{p, settings_.box, gravity_, Real(dt_), external});
-            judge(check, steps_ + 1);
-        }
-        if (needs_rebuild_) rebuild_lists();
-        const detail::wall_loads loads = interact(true);
-        if constexpr (Integrator::drifts_before_forces) for_each_index(Policy{}, n, integrate);
-        else check = checked(integrate);
-        advance_walls(walls_, settings_.walls, settings_.box, loads.force, time_, dt_, steps_ + 1);
-        if (drive_)
-            drive_work_ += transform_reduce(Policy{}, n, detail::drive_power<Precision>{p, gravity_}, 0.0, plus_op{}) *
-                           double(dt_);
-        ++steps_;
-        time_ = static_cast<double>(steps_) * static_cast<double>(dt_);
-        if constexpr (!Integrator::drifts_before_forces) judge(check, steps_);
-        for (const auto& o : observers_)
-            if (steps_ % o.first == 0) o.second(*this);
+        if (external_.size()) step_with<true>();
+        else step_with<false>();
     }
 
     /// Runs `count` steps.
@@ -307,15 +308,16 @@ public:
         return external_.data();
     }
 
-    /// Kinetic, rotational, potential and elastic energies and the dissipated energies (J).
+    /// Kinetic, rotational, potential and elastic energies and the dissipated energies (J),
+    /// summed in rank order (the same bits whatever the storage order).
     energy_budget<Coord> energy() const
     {
         auto& self = const_cast<simulation&>(*this); // views hand out mutable pointers; nothing is written
-        energy_budget<Coord> e = transform_reduce(
-            Policy{}, size(),
-            detail::particle_energy<Precision, Law>{self.particles_.view(), self.lists_.view(), settings_.box, walls_,
-                                                    pair_params_, wall_params_, settings_.gravity},
-            energy_budget<Coord>{}, plus_op{});
+        const contact_view<Real> c = self.lists_.view();
+        const detail::particle_energy<Precision, Law> each{self.particles_.view(), c, settings_.box, walls_,
+                                                           pair_params_, wall_params_, settings_.gravity};
+        energy_budget<Coord> e = transform_reduce(Policy{}, size(), detail::by_rank<decltype(each), Real>{each, c},
+                                                  energy_budget<Coord>{}, plus_op{});
         double work = drive_work_;
         for (const wall_face<Coord>& w : walls_.face) work += w.work;
         e.boundary_work = Coord(work);
@@ -371,13 +373,47 @@ public:
                 detail::fail("restore: the state's storage order is not a permutation (slot ", k, " holds ", s.storage[k], ")");
             seen[s.storage[k]] = 1;
         }
-        particles_.set_storage_order(s.storage);
-        particles_.restore(s.particles);
-        const std::vector<unsigned> user = particles_.user_indices();
-        lists_.restore(s.contacts, user);
+        // The ranks of the last rebuild follow from its positions and the user indices: the
+        // grid over those positions, in user order. The particles go back into rank order
+        // (or stay in user order without settings.reorder), whatever order the state was
+        // saved in.
+        std::vector<unsigned> identity(size());
+        for (std::size_t i = 0; i < size(); ++i) identity[i] = static_cast<unsigned>(i);
+        buffer<vec4<Coord>, Policy> x_build;
+        buffer<unsigned, Policy> users;
+        x_build.assign(s.x_at_build);
+        users.assign(identity);
+        particle_view<Precision> at_build{};
+        at_build.n = size();
+        at_build.x = x_build.data();
+        at_build.user = users.data();
+        grid_.build(at_build);
+        const grid_view<Coord> g = grid_.view();
+        const std::vector<unsigned> before = particles_.user_indices();
+        std::vector<unsigned> storage = identity;
+        if (settings_.reorder) {
+            buffer<unsigned, Policy> ranks(size());
+            for_each_index(Policy{}, size(), detail::copy_back<unsigned>{g.order, ranks.data()});
+            storage = ranks.to_host();
+        }
+        particles_.set_storage_order(storage);
+        particle_snapshot<Coord> restored = s.particles;
+        for (std::size_t i = 0; i < size(); ++i)
+            if (kinds_[i] == motion::fixed) // a fixed particle has no velocity (motion::fixed)
+                restored.v[i] = restored.omega[i] = restored.v_sync[i] = restored.omega_sync[i] = vec3<Coord>{0, 0, 0};
+        particles_.restore(restored);
+        lists_.restore(s.contacts, g, !settings_.reorder);
+        interaction_.lists_changed();
         std::vector<vec4<Coord>> slots(size());
-        for (std::size_t k = 0; k < size(); ++k) slots[k] = s.x_at_build[user[k]];
+        for (std::size_t k = 0; k < size(); ++k) slots[k] = s.x_at_build[storage[k]];
         x_at_build_.assign(slots);
+        if (external_.size()) { // external forces follow their particles into the new slots
+            const std::vector<vec3<Real>> old = external_.to_host();
+            std::vector<vec3<Real>> by_user(size()), moved(size());
+            for (std::size_t k = 0; k < size(); ++k) by_user[before[k]] = old[k];
+            for (std::size_t k = 0; k < size(); ++k) moved[k] = by_user[storage[k]];
+            external_.assign(moved);
+        }
         walls_ = s.walls;
         walls_at_build_ = s.walls_at_build;
         drive_work_ = s.drive_work;
@@ -387,11 +423,12 @@ public:
         time_ = static_cast<double>(steps_) * static_cast<double>(dt_);
     }
 
-    /// Total linear momentum, sum m v (kg m/s).
+    /// Total linear momentum, sum m v (kg m/s), summed in rank order.
     vec3<Coord> momentum() const
     {
         auto& self = const_cast<simulation&>(*this);
-        return transform_reduce(Policy{}, size(), detail::particle_momentum<Precision>{self.particles_.view()},
+        const detail::particle_momentum<Precision> each{self.particles_.view()};
+        return transform_reduce(Policy{}, size(), detail::by_rank<decltype(each), Real>{each, self.lists_.view()},
                                 vec3<Coord>{0, 0, 0}, plus_op{});
     }
 
@@ -402,7 +439,8 @@ private:
     {
         grid_.build(particles_.view());
         const grid_view<Coord> g = grid_.view();
-        lists_.rebuild(g, walls_, settings_.skin, particles_.view().user, !settings_.reorder);
+        lists_.rebuild(g, walls_, settings_.skin, !settings_.reorder);
+        interaction_.lists_changed();
         if (settings_.reorder) {
             vec4<Coord>* scratch = grid_.reusable_positions(); // the lists are built: free to reuse
             particles_.permute(g.order, scratch);
@@ -415,45 +453,112 @@ private:
         needs_rebuild_ = false;
     }
 
-    /// Every particle's contact forces, with the switches of the settings; returns the wall
-    /// loads. `update` = false leaves histories and dissipation as they are.
-    detail::wall_loads interact(bool update)
+    /// One step; `External`: the particles have external forces.
+    template <bool External>
+    void step_with()
     {
         if (settings_.energy_audit)
-            return settings_.contact_forces ? interact_with<true, true>(update) : interact_with<true, false>(update);
-        return settings_.contact_forces ? interact_with<false, true>(update) : interact_with<false, false>(update);
+            settings_.contact_forces ? step_with<External, true, true>() : step_with<External, true, false>();
+        else
+            settings_.contact_forces ? step_with<External, false, true>() : step_with<External, false, false>();
     }
 
-    template <bool Book, bool Record>
-    detail::wall_loads interact_with(bool update)
+    /// One step with the switches of the settings: `Book` the energy audit, `Record` each
+    /// contact's force. The particle check runs in the same pass as the motion: after the
+    /// drift (velocity Verlet) or after the integration.
+    template <bool External, bool Book, bool Record>
+    void step_with()
     {
+        // Views hold raw pointers into arrays that a rebuild permutes in place (their
+        // addresses stay), and external forces are permuted along with the particles.
         const particle_view<Precision> p = particles_.view();
-        return transform_reduce(Policy{}, p.n,
-                                detail::interact<Precision, Law, Book, Record, Integrator::drifts_before_forces>{
-                                    p, lists_.view(), settings_.box, walls_, pair_params_, wall_params_, Real(dt_),
-                                    update},
-                                detail::wall_loads{{0, 0, 0, 0, 0, 0}}, plus_op{});
+        const std::size_t n = p.n;
+        const vec3<Real>* external = External ? external_.data() : nullptr;
+        constexpr bool drifted = Integrator::drifts_before_forces;
+        const detail::integrate_particles<Precision, Integrator, External> integrate{p, settings_.box, gravity_,
+                                                                                   Real(dt_), external};
+        if constexpr (drifted)
+            judge(checked(detail::drift_particles<Precision, Integrator, External>{p, settings_.box, gravity_, Real(dt_),
+                                                                                  external}),
+                  steps_ + 1);
+        if (needs_rebuild_) rebuild_lists();
+        interaction_.template sum_pairs<Book, Record>(pair_contact(), lists_, summation_, true);
+        const detail::wall_loads loads = sum_walls<Book, Record>(true);
+        Coord moved2 = 0;
+        if constexpr (Book) {
+            const detail::both<detail::finish_audit<Precision>, decltype(integrate)> body{{p, Real(dt_)}, integrate};
+            if constexpr (drifted) for_each_index(Policy{}, n, body);
+            else moved2 = checked(body);
+        } else {
+            if constexpr (drifted) for_each_index(Policy{}, n, integrate);
+            else moved2 = checked(integrate);
+        }
+        advance_walls(walls_, settings_.walls, settings_.box, loads.force, time_, dt_, steps_ + 1);
+        if (drive_)
+            drive_work_ += transform_reduce(Policy{}, n,
+                                            detail::by_rank<detail::drive_power<Precision>, Real>{{p, gravity_},
+                                                                                               lists_.view()},
+                                            0.0, plus_op{}) *
+                           double(dt_);
+        ++steps_;
+        time_ = static_cast<double>(steps_) * static_cast<double>(dt_);
+        if constexpr (!drifted) judge(moved2, steps_);
+        for (const auto& o : observers_)
+            if (steps_ % o.first == 0) o.second(*this);
+    }
+
+    /// The forces of the current positions, leaving the contacts' histories and the energy
+    /// audit as they are (for an integrator that needs the forces before its first step).
+    template <bool Record>
+    void initial_forces()
+    {
+        interaction_.template sum_pairs<false, Record>(pair_contact(), lists_, summation_, false);
+        sum_walls<false, Record>(false);
+    }
+
+    detail::pair_contact<Precision, Law, Integrator::drifts_before_forces> pair_contact()
+    {
+        return {particles_.view(), settings_.box, pair_params_, Real(dt_)};
+    }
+
+    /// Adds the wall contacts to the forces of the particles that have some; returns their
+    /// loads on the walls, summed in rank order (whatever the storage order).
+    template <bool Book, bool Record>
+    detail::wall_loads sum_walls(bool update_history)
+    {
+        const detail::wall_contacts<Precision, Law, Book, Record, Integrator::drifts_before_forces> walls{
+            particles_.view(), lists_.view(), lists_.wall_ranks(), walls_, wall_params_, Real(dt_), update_history};
+        return transform_reduce(Policy{}, lists_.wall_particles(), walls, detail::wall_loads{{0, 0, 0, 0, 0, 0}},
+                                plus_op{});
     }
 
     /// Runs the particle kernel `body` on every particle and checks each one after it, in one
     /// pass (a particle outside the walls, non-finite values, the largest displacement since
-    /// the lists were built).
+    /// the lists were built); returns the largest squared displacement, +infinity when a
+    /// particle failed the check.
     template <class Body>
-    detail::step_check<Coord> checked(const Body& body)
+    Coord checked(const Body& body)
     {
         const particle_view<Precision> p = particles_.view();
-        const detail::check_particle<Precision> check{p, x_at_build_.data(), settings_.box, walls_};
-        return transform_reduce(Policy{}, p.n, detail::then_check<Body, Precision>{body, check},
-                                detail::step_check<Coord>{0, ~std::size_t(0)}, detail::combine_checks{});
+        return transform_reduce(Policy{}, p.n, detail::then_check<Body, Precision>{body, check()}, Coord(0), max_op{});
     }
 
-    /// Acts on the particle check of step `step`: a sphere::error naming the step and the
-    /// particle; marks the lists for a rebuild when a particle and a wall may have come closer
-    /// than the skin.
-    void judge(const detail::step_check<Coord>& check, std::size_t step)
+    detail::check_particle<Precision> check()
     {
-        if (check.first_bad != ~std::size_t(0)) report_bad_particle(check.first_bad, step);
-        const double moved = std::sqrt(double(check.max_displacement2)), skin = double(settings_.skin);
+        return {particles_.view(), x_at_build_.data(), settings_.box, walls_};
+    }
+
+    /// Acts on the particle check of step `step` (the largest squared displacement): a
+    /// sphere::error naming the step and the particle (the lowest user index) when one failed
+    /// it; marks the lists for a rebuild when a particle and a wall may have come closer than
+    /// the skin.
+    void judge(Coord moved2, std::size_t step)
+    {
+        if (!std::isfinite(moved2))
+            report_bad_particle(transform_reduce(Policy{}, size(), detail::bad_particle<Precision>{check()},
+                                                 ~std::size_t(0), min_op{}),
+                                step);
+        const double moved = std::sqrt(double(moved2)), skin = double(settings_.skin);
         bool rebuild = 2 * moved > skin;
         for (int f = 0; f < wall_set<Coord>::count; ++f)
             if (walls_.face[f].active && std::fabs(walls_.face[f].position - walls_at_build_.face[f].position) + moved > skin)
@@ -518,6 +623,8 @@ private:
     wall_set<Coord> walls_;
     neighbor_grid<Coord, Policy> grid_;
     contact_lists<Precision, Policy> lists_;
+    interaction<Precision, Policy> interaction_;
+    pair_summation summation_ = pair_summation::slabs; ///< settings_.pair_summation, resolved for the backend
     buffer<vec4<Coord>, Policy> x_at_build_;
     wall_set<Coord> walls_at_build_;      ///< the walls when the lists were built
     bool drive_ = false;                  ///< some particle is prescribed: book the drive's work

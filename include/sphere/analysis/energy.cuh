@@ -7,7 +7,7 @@
 #include "../boundary/walls.cuh"
 #include "../boundary/world.cuh"
 #include "../contact/contact_lists.cuh"
-#include "../contact/interact.cuh"
+#include "../contact/evaluate.cuh"
 #include "../contact/params.cuh"
 #include "../particles/state.cuh"
 
@@ -48,9 +48,9 @@ struct energy_budget {
 
 namespace detail {
 
-/// Particle i's share of the energy budget: its own energies, its dissipation, half the
-/// elastic energy of each pair contact and all of its wall contacts. Summed in coord_t<P>,
-/// the user-facing type; overlaps formed as in the interaction kernel.
+/// Particle i's share of the energy budget: its own energies, its dissipation, the elastic
+/// energy of the pair contacts it owns in the contact lists and of its wall contacts. Summed
+/// in coord_t<P>, the user-facing type; overlaps formed as in the interaction.
 template <class P, class Law>
 struct particle_energy {
     using Real = real_t<P>;
@@ -71,7 +71,8 @@ struct particle_energy {
         e.kinetic = Coord(0.5) * m * Coord(norm2(p.v_sync[i]));
         e.rotational = Coord(0.2) * m * xi.w * xi.w * Coord(norm2(p.omega_sync[i]));
         e.potential = -m * dot(gravity, xi.xyz());
-        for (unsigned k = c.offset[i]; k < c.offset[i + 1]; ++k) {
+        const std::size_t r = c.rank(i);
+        for (unsigned k = c.offset[r]; k < c.offset[r + 1]; ++k) {
             const unsigned j = c.partner[k];
             if (j < wall_partner_base) {
                 const vec4<Coord> xj = p.x[j];
@@ -80,7 +81,7 @@ struct particle_energy {
                 if (!(dist2 < reach * reach)) continue;
                 vec3<Real> n;
                 const Real delta_n = overlap_and_normal(d, dist2, reach, n);
-                if (delta_n < Real(0)) e.elastic += Coord(Law::pair_energy(pair_params, delta_n, c.history[k]) / 2);
+                if (delta_n < Real(0)) e.elastic += Coord(Law::pair_energy(pair_params, delta_n, c.history[k]));
             } else {
                 const int f = static_cast<int>(j - wall_partner_base);
                 const int a = f / 2;

@@ -34,16 +34,21 @@ struct world {
 
     /// The nearest image of the separation of two positions that both lie inside the box
     /// (wrapped): one conditional shift per periodic axis, no division. The same result as
-    /// nearest_image for such separations (|d| < L), up to a tie at exactly L / 2.
-    SPHERE_HDI vec3<Real> nearest_image_inside(vec3<Real> d) const
+    /// nearest_image for such separations (|d| < L), up to a tie at exactly L / 2. Written with
+    /// selects only, so that it vectorises in a loop over pairs.
+    SPHERE_HDI vec3<Real> nearest_image_inside(const vec3<Real>& d) const
     {
-        for (int a = 0; a < 3; ++a)
-            if (periodic(a)) {
-                const Real l = length(a);
-                if (d[a] > l / 2) d[a] -= l;
-                else if (d[a] < -l / 2) d[a] += l;
-            }
-        return d;
+        return {shortest(d.x, hi.x - lo.x, periodic(0)), shortest(d.y, hi.y - lo.y, periodic(1)),
+                shortest(d.z, hi.z - lo.z, periodic(2))};
+    }
+
+    /// d shifted by one period l towards zero when it is more than half a period away, on a
+    /// periodic axis.
+    SPHERE_HDI static Real shortest(Real d, Real l, bool periodic_axis)
+    {
+        const Real half = l / 2;
+        const Real shifted = d > half ? d - l : (d < -half ? d + l : d);
+        return periodic_axis ? shifted : d;
     }
 
     /// Maps a coordinate on a periodic axis into [lo, hi), however many periods away it is;

@@ -1,15 +1,23 @@
 #pragma once
 /// \file
-/// Contact lists with history, in compressed rows (CSR): the entries of the particle in storage
-/// slot k are [offset[k], offset[k + 1]), one for every particle j with
-/// |x_k - x_j| < r_k + r_j + skin and one for every wall face within r_k + skin, at the last
-/// rebuild. Each entry holds its history (tangential displacement, sliding flag) and, when
-/// recorded, the force of the last step. The lists hold what they find: no capacity to set.
+/// Contact lists with history, each pair listed once (a half list), in compressed rows (CSR).
 ///
-/// Entries are sorted by the partner's *user* index (walls last, by face), so the order in
-/// which a particle sums its contact forces does not depend on where particles are stored, and
-/// the history is carried across rebuilds (and the storage permutation that comes with them)
-/// by user index.
+/// At every rebuild the neighbour grid sorts the particles by cell (ties by user index); a
+/// particle's position in that order is its *rank*, and the grid's cells are numbered layer
+/// after layer along its slow axis (grid/geometry.cuh), so each layer is a range of ranks. A
+/// pair {a, b} with |x_a - x_b| < r_a + r_b + skin is owned by one of the two: the one whose
+/// layer comes first (b in the next layer, cyclically on a periodic axis), or, in the same
+/// layer, the one of lower rank. The row of rank r lists the partners it owns, by partner rank,
+/// then every wall face within r + skin (by face). Each entry holds the contact's history
+/// (tangential displacement as seen by the owner, sliding flag) and, when recorded, the force
+/// of the last step. The lists hold what they find: no capacity to set.
+///
+/// Ranks and ownership depend on the positions at the rebuild and the user indices alone, so
+/// the interaction, which follows them (contact/interact.cuh), gives the same bits whether or
+/// not the particles are stored in rank order (settings.reorder) and whatever the thread count.
+/// Histories are carried across rebuilds by particle, from the owner's old row or, negated,
+/// from the partner's when the ownership changed.
+#include <algorithm>
 #include <cstddef>
 #include <limits>
 #include <vector>
@@ -25,21 +33,36 @@
 
 namespace sphere {
 
-/// Partner codes from here up name a wall face: wall_partner_base + f. Particle (user and
-/// storage) indices stay below it.
+/// Partner codes from here up name a wall face: wall_partner_base + f. Particle indices stay
+/// below it.
 inline constexpr unsigned wall_partner_base = 0xFFFFFFF0u;
 
-/// Kernel view of the contact lists (storage order).
+/// A contact's history as seen from its other particle: the tangential displacement reversed,
+/// the sliding flag kept.
+template <class Real>
+SPHERE_HDI vec4<Real> mirrored_history(const vec4<Real>& h)
+{
+    return {-h.x, -h.y, -h.z, h.w};
+}
+
+/// Kernel view of the contact lists.
 template <class Real>
 struct contact_view {
-    const unsigned* offset;  ///< entries of slot k: [offset[k], offset[k + 1])
-    const unsigned* partner; ///< storage slot of the partner, or wall_partner_base + f
-    vec4<Real>* history;     ///< delta_t (m) in xyz, sliding flag in w
-    vec4<Real>* force;       ///< f_t on this particle (N) in xyz, f_n . n (N) in w; null when not recorded
+    std::size_t n;                ///< particles
+    const unsigned* offset;       ///< entries of rank r: [offset[r], offset[r + 1])
+    const unsigned* partner;      ///< storage slot of the partner, or wall_partner_base + f (walls last)
+    vec4<Real>* history;          ///< delta_t (m) seen by the owner in xyz, sliding flag in w
+    vec4<Real>* force;            ///< f_t on the owner (N) in xyz, f_n . n (N) in w; null when not recorded
+    const unsigned* slot_of_rank; ///< storage slot of each rank; null when they coincide (settings.reorder)
+    const unsigned* rank_of_slot; ///< the inverse; null when they coincide
+
+    SPHERE_HDI std::size_t slot(std::size_t r) const { return slot_of_rank ? slot_of_rank[r] : r; }
+    SPHERE_HDI std::size_t rank(std::size_t s) const { return rank_of_slot ? rank_of_slot[s] : s; }
 };
 
-/// A host copy of the contact lists in user order: entries of particle i at
-/// [offset[i], offset[i + 1]), partners as user indices (or wall_partner_base + f).
+/// A host copy of the contact lists in user order, each pair from both sides: entries of
+/// particle i at [offset[i], offset[i + 1]), partners as user indices sorted ascending, then
+/// walls (wall_partner_base + f). The history and force of an entry are as seen by particle i.
 template <class Real>
 struct contact_table {
     std::vector<std::size_t> offset{0};
@@ -68,56 +91,68 @@ struct contact_table {
 };
 
 namespace detail {
-/// Scans the neighbour cells of the particle at new (sorted) position k and visits every
-/// partner within reach, and every active wall within r + skin: `visit(partner_code, key)`
-/// with the partner's new slot (or wall code) and its sort key (user index, or the wall code).
+/// Scans the cells around the particle at rank k and visits the partners it owns within reach
+/// (`pair(q)` with the partner's rank q) and then every active wall within r + skin
+/// (`wall(f)`). Owned partners lie in k's own layer at a higher rank or in the next layer,
+/// so only those two layers are scanned.
 template <class Real>
 struct neighbour_scan {
     grid_view<Real> grid;
     wall_set<Real> walls;
     Real skin;
-    const unsigned* user; ///< user index of each slot *before* the permutation (grid.order maps)
-    bool keep_order;      ///< the particles stay in their slots: lists and partners by old slot
-
-    /// The slot the particle at sorted position k will have: k after the permutation into
-    /// the grid's order, its old slot when the order is kept.
-    SPHERE_HD unsigned slot(std::size_t k) const { return keep_order ? grid.order[k] : static_cast<unsigned>(k); }
 
     template <class Visit>
     SPHERE_HD void operator()(std::size_t k, Visit& visit) const
     {
         const grid_geometry<Real>& g = grid.geometry;
         const vec4<Real> xi = grid.sorted_x[k];
-        const int ci[3] = {g.coordinate(xi.x, 0), g.coordinate(xi.y, 1), g.coordinate(xi.z, 2)};
-        const int nx = static_cast<int>(g.n[0]);
-        for (int dz = -1; dz <= 1; ++dz)
-            for (int dy = -1; dy <= 1; ++dy) {
-                int cy = ci[1] + dy, cz = ci[2] + dz;
-                if (!wrap_or_reject(cy, 1) || !wrap_or_reject(cz, 2)) continue;
-                // The row's cells ci[0]-1 .. ci[0]+1 along x: one run of sorted positions, or two
-                // when a periodic x wraps around.
-                int x0 = ci[0] - 1, x1 = ci[0] + 1;
-                int wrapped0 = 0, wrapped1 = -1;
-                if (g.box.periodic(0)) {
-                    if (x0 < 0) { wrapped0 = wrapped1 = nx - 1; x0 = 0; }
-                    if (x1 >= nx) { wrapped0 = wrapped1 = 0; x1 = nx - 1; }
-                } else {
-                    x0 = x0 < 0 ? 0 : x0;
-                    x1 = x1 >= nx ? nx - 1 : x1;
-                }
-                scan_run(k, xi, g.index(x0, cy, cz), g.index(x1, cy, cz), visit);
-                if (wrapped1 >= 0) scan_run(k, xi, g.index(wrapped0, cy, cz), g.index(wrapped1, cy, cz), visit);
+        int ci[3];
+        for (int a = 0; a < 3; ++a) ci[a] = g.coordinate(xi.xyz()[a], a);
+        const int layers = static_cast<int>(g.n[g.slow]), nf = static_cast<int>(g.n[g.fast]);
+        for (int ds = 0; ds <= 1; ++ds) {
+            int c[3] = {ci[0], ci[1], ci[2]};
+            c[g.slow] += ds;
+            if (c[g.slow] == layers) {
+                // the next layer of the last one: the first, on a periodic axis with more than
+                // two layers (with two, the first is also the previous one and owns the pair)
+                if (!g.box.periodic(g.slow) || layers < 3) continue;
+                c[g.slow] = 0;
             }
+            for (int dm = -1; dm <= 1; ++dm) {
+                c[g.mid] = ci[g.mid] + dm;
+                if (!wrap_or_reject(c[g.mid], g.mid)) continue;
+                // The cells ci[fast] - 1 .. ci[fast] + 1 along the fast axis: one run of ranks,
+                // or two when a periodic axis wraps around.
+                int f0 = ci[g.fast] - 1, f1 = ci[g.fast] + 1;
+                int wrapped0 = 0, wrapped1 = -1;
+                if (g.box.periodic(g.fast)) {
+                    if (f0 < 0) { wrapped0 = wrapped1 = nf - 1; f0 = 0; }
+                    if (f1 >= nf) { wrapped0 = wrapped1 = 0; f1 = nf - 1; }
+                } else {
+                    f0 = f0 < 0 ? 0 : f0;
+                    f1 = f1 >= nf ? nf - 1 : f1;
+                }
+                const std::size_t above = ds == 0 ? k + 1 : 0; // same layer: higher ranks only
+                scan_run(xi, run_cell(c, f0), run_cell(c, f1), above, visit);
+                if (wrapped1 >= 0) scan_run(xi, run_cell(c, wrapped0), run_cell(c, wrapped1), above, visit);
+            }
+        }
         for (int f = 0; f < wall_set<Real>::count; ++f) {
             const wall_face<Real>& w = walls.face[f];
             if (!w.active) continue;
             const int a = f / 2;
             const Real gap = (xi.xyz()[a] - Real(w.position)) * wall_set<Real>::inward_normal(f)[a] - xi.w;
-            if (gap < skin) visit(wall_partner_base + unsigned(f), wall_partner_base + unsigned(f));
+            if (gap < skin) visit.wall(f);
         }
     }
 
 private:
+    SPHERE_HD unsigned run_cell(int c[3], int f) const
+    {
+        c[grid.geometry.fast] = f;
+        return grid.geometry.index(c);
+    }
+
     /// Wraps cell coordinate c on a periodic axis; false when it lies outside a wall axis.
     SPHERE_HD bool wrap_or_reject(int& c, int a) const
     {
@@ -130,23 +165,24 @@ private:
     }
 
     template <class Visit>
-    SPHERE_HD void scan_run(std::size_t k, const vec4<Real>& xi, unsigned first_cell, unsigned last_cell,
+    SPHERE_HD void scan_run(const vec4<Real>& xi, unsigned first_cell, unsigned last_cell, std::size_t above,
                             Visit& visit) const
     {
         const unsigned end = grid.cell_start[last_cell + 1];
-        for (unsigned q = grid.cell_start[first_cell]; q < end; ++q) {
-            if (q == k) continue;
+        unsigned q = grid.cell_start[first_cell];
+        if (q < above) q = static_cast<unsigned>(above < end ? above : end);
+        for (; q < end; ++q) {
             const vec4<Real> xj = grid.sorted_x[q];
             const Real reach = xi.w + xj.w + skin;
-            if (norm2(grid.geometry.box.nearest_image(xi.xyz() - xj.xyz())) < reach * reach)
-                visit(slot(q), user[grid.order[q]]);
+            if (norm2(grid.geometry.box.nearest_image(xi.xyz() - xj.xyz())) < reach * reach) visit.pair(q);
         }
     }
 };
 
 struct count_visit {
     unsigned found = 0;
-    SPHERE_HD void operator()(unsigned, unsigned) { ++found; }
+    SPHERE_HD void pair(unsigned) { ++found; }
+    SPHERE_HD void wall(int) { ++found; }
 };
 
 template <class Real>
@@ -157,69 +193,111 @@ struct count_entries {
     {
         count_visit v;
         scan(k, v);
-        count[scan.slot(k)] = v.found;
+        count[k] = v.found;
     }
 };
 
+/// Writes partner ranks (sort keys) and wall codes in visit order.
 struct fill_visit {
-    unsigned* partner;
     unsigned* key;
     unsigned found = 0;
-    SPHERE_HD void operator()(unsigned code, unsigned sort_key)
+    SPHERE_HD void pair(unsigned q) { key[found++] = q; }
+    SPHERE_HD void wall(int f) { key[found++] = wall_partner_base + unsigned(f); }
+};
+
+/// The old lists, for carrying histories over: rows by old rank, partners as old slots.
+template <class Real>
+struct old_lists {
+    const unsigned* offset;
+    const unsigned* partner;
+    const vec4<Real>* history;
+    const unsigned* rank_of_slot; ///< null when old ranks and slots coincide
+
+    /// The history of the entry of old slot `owner` for `code` (an old slot or a wall code);
+    /// false when there is none.
+    SPHERE_HD bool find(unsigned owner, unsigned code, vec4<Real>& h) const
     {
-        partner[found] = code;
-        key[found] = sort_key;
-        ++found;
+        const unsigned r = rank_of_slot ? rank_of_slot[owner] : owner;
+        for (unsigned m = offset[r]; m < offset[r + 1]; ++m)
+            if (partner[m] == code) {
+                h = history[m];
+                return true;
+            }
+        return false;
     }
 };
 
-/// Fills the new list of sorted position k, sorted by partner key, and carries over the
-/// history of the partners that the particle's old list (at its old slot) already had.
-/// Positions in Coord, histories in Real.
+/// Fills the new row of rank k: partners by rank (stored as slots: the rank itself once the
+/// particles are permuted into rank order, the grid's old slot with `keep_order`), walls last,
+/// and carries over the history each contact had in the old lists.
 template <class Coord, class Real>
 struct fill_entries {
     neighbour_scan<Coord> scan;
     const unsigned* offset;
     unsigned* partner;
-    unsigned* key; ///< scratch: each entry's sort key
     vec4<Real>* history;
-    const unsigned* old_offset;
-    const unsigned* old_partner;
-    const vec4<Real>* old_history;
+    old_lists<Real> old;
+    bool keep_order;
 
     SPHERE_HD void operator()(std::size_t k) const
     {
-        const unsigned at = scan.slot(k), begin = offset[at], n = offset[at + 1] - begin;
-        fill_visit v{partner + begin, key + begin};
-        scan(k, v);
+        const unsigned begin = offset[k], n = offset[k + 1] - begin;
         unsigned* p = partner + begin;
-        unsigned* s = key + begin;
-        for (unsigned a = 1; a < n; ++a) { // insertion sort by key: lists are short
-            const unsigned pv = p[a], sv = s[a];
+        fill_visit v{p};
+        scan(k, v);
+        unsigned pairs = 0;
+        while (pairs < n && p[pairs] < wall_partner_base) ++pairs;
+        for (unsigned a = 1; a < pairs; ++a) { // insertion sort by rank: rows are short
+            const unsigned q = p[a];
             unsigned b = a;
-            for (; b > 0 && s[b - 1] > sv; --b) {
-                p[b] = p[b - 1];
-                s[b] = s[b - 1];
-            }
-            p[b] = pv;
-            s[b] = sv;
+            for (; b > 0 && p[b - 1] > q; --b) p[b] = p[b - 1];
+            p[b] = q;
         }
-        const unsigned o = scan.grid.order[k]; // the particle's slot before the permutation
-        const unsigned old_begin = old_offset[o], old_end = old_offset[o + 1];
-        unsigned m = old_begin;
+        const unsigned* order = scan.grid.order; // old slot of each rank
+        const unsigned me = order[k];
         for (unsigned a = 0; a < n; ++a) {
-            // old partners are old slots: their keys are user indices (or wall codes)
-            while (m < old_end && old_key(m) < s[a]) ++m;
-            history[begin + a] = (m < old_end && old_key(m) == s[a]) ? old_history[m] : vec4<Real>{0, 0, 0, 0};
+            const unsigned code = p[a];
+            vec4<Real> h{0, 0, 0, 0};
+            if (code >= wall_partner_base) {
+                old.find(me, code, h);
+            } else {
+                const unsigned them = order[code];
+                if (!old.find(me, them, h) && old.find(them, me, h)) h = mirrored_history(h);
+                p[a] = keep_order ? them : code;
+            }
+            history[begin + a] = h;
         }
     }
+};
 
-private:
-    SPHERE_HD unsigned old_key(unsigned m) const
+/// Whether rank r has wall entries (1 or 0), for the list of such ranks.
+struct has_walls {
+    const unsigned* offset;
+    const unsigned* partner;
+    unsigned* flag;
+    SPHERE_HD void operator()(std::size_t r) const
     {
-        const unsigned q = old_partner[m];
-        return q >= wall_partner_base ? q : scan.user[q];
+        const unsigned end = offset[r + 1];
+        flag[r] = end > offset[r] && partner[end - 1] >= wall_partner_base ? 1u : 0u;
     }
+};
+
+/// Writes rank r at its place in the list of ranks with wall entries (`place`: the exclusive
+/// scan of has_walls' flags).
+struct list_wall_ranks {
+    const unsigned* place;
+    unsigned* ranks;
+    SPHERE_HD void operator()(std::size_t r) const
+    {
+        if (place[r + 1] > place[r]) ranks[place[r]] = static_cast<unsigned>(r);
+    }
+};
+
+/// Inverse of a permutation: inverse[order[k]] = k.
+struct invert_permutation {
+    const unsigned* order;
+    unsigned* inverse;
+    SPHERE_HD void operator()(std::size_t k) const { inverse[order[k]] = static_cast<unsigned>(k); }
 };
 } // namespace detail
 
@@ -233,48 +311,72 @@ public:
 
     contact_lists() = default;
     /// Empty lists for n particles; `record_forces` keeps each entry's force of the last step.
-    contact_lists(std::size_t n, bool record_forces)
-        : record_forces_(record_forces), offset_(n + 1, 0u), new_offset_(n + 1, 0u)
-    {
-    }
+    contact_lists(std::size_t n, bool record_forces) : record_forces_(record_forces), offset_(n + 1, 0u) {}
 
     std::size_t size() const { return offset_.size() - 1; }
-    /// Entries in all lists.
+    /// Entries in all lists: each pair once, and each particle's walls within reach.
     std::size_t entries() const { return entries_; }
     bool records_forces() const { return record_forces_; }
+    /// The first rank of each layer of the grid along its slow axis, and one past the last
+    /// (host copy, from the last rebuild).
+    const std::vector<unsigned>& layer_start() const { return layer_start_; }
+    /// Whether the slow axis of the grid of the last rebuild is periodic.
+    bool periodic_layers() const { return periodic_layers_; }
+    /// Entries of ranks [0, r) for each r of layer_start() (host copy, from the last rebuild).
+    const std::vector<unsigned>& layer_entries() const { return layer_entries_; }
+    /// The ranks that have wall entries, ascending (policy memory), and how many.
+    const unsigned* wall_ranks() const { return wall_ranks_.data(); }
+    std::size_t wall_particles() const { return wall_particles_; }
 
-    /// Rebuilds every list from a grid built over the particles before their permutation into
-    /// the grid's order (`user` is the user index of each slot before it): the new lists are
-    /// in the new order, or in the old one with `keep_order`. Walls within r + skin are listed too.
-    void rebuild(const grid_view<Coord>& grid, const wall_set<Coord>& walls, Coord skin, const unsigned* user,
-                 bool keep_order = false)
+    /// Rebuilds every list from a grid built over the particles in their current slots. The
+    /// new lists are in the grid's order (its ranks); partners are stored as ranks, to be the
+    /// slots once the caller permutes the particles into that order, or, with `keep_order`,
+    /// as the current slots, which the particles keep. Walls within r + skin are listed too.
+    void rebuild(const grid_view<Coord>& grid, const wall_set<Coord>& walls, Coord skin, bool keep_order)
     {
         const std::size_t n = size();
-        const detail::neighbour_scan<Coord> scan{grid, walls, skin, user, keep_order};
-        for_each_index(Policy{}, n, detail::count_entries<Coord>{scan, new_offset_.data()});
-        const std::size_t total = exclusive_scan_in_place(Policy{}, new_offset_.data(), n + 1);
+        const detail::neighbour_scan<Coord> scan{grid, walls, skin};
+        buffer<unsigned, Policy> offset(n + 1, 0u);
+        for_each_index(Policy{}, n, detail::count_entries<Coord>{scan, offset.data()});
+        const std::size_t total = exclusive_scan_in_place(Policy{}, offset.data(), n + 1);
         if (total >= std::size_t(std::numeric_limits<unsigned>::max()))
             detail::fail("contact lists: ", total, " entries within r_i + r_j + skin, more than 2^32 - 1; reduce the skin");
-        for (buffer<unsigned, Policy>* b : {&new_partner_, &key_})
-            if (b->size() < total) b->resize(total);
-        if (new_history_.size() < total) new_history_.resize(total);
+        buffer<unsigned, Policy> partner(total);
+        buffer<vec4<Real>, Policy> history(total);
+        const detail::old_lists<Real> old{offset_.data(), partner_.data(), history_.data(),
+                                          keep_order_ ? rank_of_slot_.data() : nullptr};
         for_each_index(Policy{}, n,
-                       detail::fill_entries<Coord, Real>{scan, new_offset_.data(), new_partner_.data(), key_.data(),
-                                                  new_history_.data(), offset_.data(), partner_.data(),
-                                                  history_.data()});
-        offset_.swap(new_offset_);
-        partner_.swap(new_partner_);
-        history_.swap(new_history_);
+                       detail::fill_entries<Coord, Real>{scan, offset.data(), partner.data(), history.data(), old,
+                                                         keep_order});
+        offset_.swap(offset);
+        partner_.swap(partner);
+        history_.swap(history);
         entries_ = total;
-        if (record_forces_ && force_.size() < total) force_.resize(total); // the interaction writes every entry
+        if (record_forces_) force_ = buffer<vec4<Real>, Policy>(total, vec4<Real>{0, 0, 0, 0});
+        if (keep_order) {
+            slot_of_rank_.resize(n);
+            rank_of_slot_.resize(n);
+            for_each_index(Policy{}, n, detail::copy_back<unsigned>{grid.order, slot_of_rank_.data()});
+            for_each_index(Policy{}, n, detail::invert_permutation{grid.order, rank_of_slot_.data()});
+        }
+        keep_order_ = keep_order;
+        set_layers(grid);
+        set_wall_ranks();
     }
 
     contact_view<Real> view()
     {
-        return {offset_.data(), partner_.data(), history_.data(), record_forces_ ? force_.data() : nullptr};
+        return {size(),
+                offset_.data(),
+                partner_.data(),
+                history_.data(),
+                record_forces_ ? force_.data() : nullptr,
+                keep_order_ ? slot_of_rank_.data() : nullptr,
+                keep_order_ ? rank_of_slot_.data() : nullptr};
     }
 
-    /// A host copy in user order; `user` is the user index of each storage slot.
+    /// A host copy in user order, each pair from both sides; `user` is the user index of each
+    /// storage slot.
     contact_table<Coord> table(const std::vector<unsigned>& user) const
     {
         const std::size_t n = size();
@@ -282,63 +384,164 @@ public:
         const std::vector<vec4<Real>> hist = history_.to_host();
         std::vector<vec4<Real>> frc;
         if (record_forces_) frc = force_.to_host();
-        std::vector<std::size_t> slot_of(n);
-        for (std::size_t k = 0; k < n; ++k) slot_of[user[k]] = k;
+        const std::vector<unsigned> slots = keep_order_ ? slot_of_rank_.to_host() : std::vector<unsigned>{};
+        // every entry twice (pairs) or once (walls), as (particle, partner, entry, mirrored)
+        struct item {
+            unsigned particle, partner, entry;
+            bool mirrored;
+        };
+        std::vector<item> items;
+        items.reserve(2 * part.size());
+        for (std::size_t r = 0; r < n; ++r) {
+            const unsigned me = user[keep_order_ ? slots[r] : r];
+            for (unsigned e = off[r]; e < off[r + 1]; ++e) {
+                if (part[e] >= wall_partner_base) {
+                    items.push_back({me, part[e], e, false});
+                } else {
+                    items.push_back({me, user[part[e]], e, false});
+                    items.push_back({user[part[e]], me, e, true});
+                }
+            }
+        }
+        std::sort(items.begin(), items.end(), [](const item& a, const item& b) {
+            return a.particle != b.particle ? a.particle < b.particle : a.partner < b.partner;
+        });
         contact_table<Coord> t;
         t.offset.assign(n + 1, 0);
-        for (std::size_t i = 0; i < n; ++i) t.offset[i + 1] = t.offset[i] + (off[slot_of[i] + 1] - off[slot_of[i]]);
-        t.partner.resize(t.offset[n]);
-        t.history.resize(t.offset[n]);
-        if (record_forces_) t.force.resize(t.offset[n]);
-        for (std::size_t i = 0; i < n; ++i) {
-            std::size_t e = t.offset[i];
-            for (unsigned s = off[slot_of[i]]; s < off[slot_of[i] + 1]; ++s, ++e) {
-                t.partner[e] = part[s] >= wall_partner_base ? part[s] : user[part[s]];
-                t.history[e] = vec_cast<Coord>(hist[s]);
-                if (record_forces_) t.force[e] = vec_cast<Coord>(frc[s]);
+        for (const item& it : items) ++t.offset[it.particle + 1];
+        for (std::size_t i = 0; i < n; ++i) t.offset[i + 1] += t.offset[i];
+        t.partner.reserve(items.size());
+        t.history.reserve(items.size());
+        if (record_forces_) t.force.reserve(items.size());
+        for (const item& it : items) {
+            t.partner.push_back(it.partner);
+            const vec4<Real> h = hist[it.entry];
+            t.history.push_back(vec_cast<Coord>(it.mirrored ? mirrored_history(h) : h));
+            if (record_forces_) {
+                const vec4<Real> f = frc[it.entry];
+                // the partner feels the opposite tangential force; f_n . n is the same
+                t.force.push_back(vec_cast<Coord>(it.mirrored ? vec4<Real>{-f.x, -f.y, -f.z, f.w} : f));
             }
         }
         return t;
     }
 
-    /// Replaces the lists and their history by a table in user order (for restarts); `user`
-    /// is the user index of each storage slot. Throws when the table does not fit.
-    void restore(const contact_table<Coord>& t, const std::vector<unsigned>& user)
+    /// Replaces the lists by a table in user order (for restarts): `grid` is built over the
+    /// positions of the last rebuild in user order (its `order` holds the user index of each
+    /// rank), and the particles are stored in rank order unless `keep_order` (then in user
+    /// order). Each pair takes the history its owner's entry has in the table. Throws when the
+    /// table does not fit or is not symmetric.
+    void restore(const contact_table<Coord>& t, const grid_view<Coord>& grid, bool keep_order)
     {
         const std::size_t n = size();
         if (t.particles() != n || t.partner.size() != t.offset[n] || t.history.size() != t.partner.size())
             detail::fail("contact lists: the restored table does not fit ", n, " particles");
-        std::vector<unsigned> slot_of(n);
-        for (std::size_t k = 0; k < n; ++k) slot_of[user[k]] = static_cast<unsigned>(k);
+        const std::vector<unsigned> user_of_rank = buffer_copy(grid.order, n);
+        const std::vector<vec4<Coord>> x = buffer_copy(grid.sorted_x, n);
+        std::vector<unsigned> rank_of_user(n);
+        for (std::size_t r = 0; r < n; ++r) rank_of_user[user_of_rank[r]] = static_cast<unsigned>(r);
+        const grid_geometry<Coord>& g = grid.geometry;
+        auto layer = [&](unsigned r) { return g.coordinate(x[r].xyz()[g.slow], g.slow); };
+        const int layers = static_cast<int>(g.n[g.slow]);
+        auto owns = [&](unsigned a, unsigned b) { // ranks
+            const int la = layer(a), lb = layer(b);
+            if (la == lb) return a < b;
+            return lb == la + 1 || (g.box.periodic(g.slow) && layers >= 3 && la == layers - 1 && lb == 0);
+        };
         std::vector<unsigned> off(n + 1, 0), part;
         std::vector<vec4<Real>> hist;
-        for (std::size_t k = 0; k < n; ++k) {
-            const std::size_t i = user[k];
+        for (std::size_t r = 0; r < n; ++r) {
+            const unsigned i = user_of_rank[r];
+            std::vector<std::pair<unsigned, vec4<Real>>> row, walls; // (partner rank or wall code, history)
             for (std::size_t e = t.begin(i); e < t.end(i); ++e) {
                 const unsigned j = t.partner[e];
-                if (j < wall_partner_base && j >= n)
-                    detail::fail("contact lists: particle ", i, " lists partner ", j, ", but there are ", n, " particles");
-                if (j >= wall_partner_base + unsigned(wall_set<Real>::count))
-                    detail::fail("contact lists: particle ", i, " lists wall code ", j, ", not a wall face");
-                part.push_back(j >= wall_partner_base ? j : slot_of[j]);
-                hist.push_back(vec_cast<Real>(t.history[e]));
+                if (j >= wall_partner_base) {
+                    if (j >= wall_partner_base + unsigned(wall_set<Coord>::count))
+                        detail::fail("contact lists: particle ", i, " lists wall code ", j, ", not a wall face");
+                    walls.emplace_back(j, vec_cast<Real>(t.history[e]));
+                    continue;
+                }
+                if (j >= n) detail::fail("contact lists: particle ", i, " lists partner ", j, ", but there are ", n, " particles");
+                if (t.find(j, unsigned(i)) == ~std::size_t(0))
+                    detail::fail("contact lists: particle ", i, " lists partner ", j, ", but ", j, " does not list ", i);
+                const unsigned q = rank_of_user[j];
+                if (!owns(unsigned(r), q) && !owns(q, unsigned(r)))
+                    detail::fail("contact lists: particle ", i, " lists partner ", j,
+                                 ", but their positions at the last rebuild lie more than one grid layer apart");
+                if (owns(unsigned(r), q)) row.emplace_back(q, vec_cast<Real>(t.history[e]));
             }
-            off[k + 1] = static_cast<unsigned>(part.size());
+            std::sort(row.begin(), row.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+            std::sort(walls.begin(), walls.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+            for (const auto& [q, h] : row) {
+                part.push_back(keep_order ? user_of_rank[q] : q);
+                hist.push_back(h);
+            }
+            for (const auto& [code, h] : walls) {
+                part.push_back(code);
+                hist.push_back(h);
+            }
+            off[r + 1] = static_cast<unsigned>(part.size());
         }
         offset_.assign(off);
         partner_.assign(part);
         history_.assign(hist);
         entries_ = part.size();
         if (record_forces_) force_.assign(std::vector<vec4<Real>>(part.size(), vec4<Real>{0, 0, 0, 0}));
+        keep_order_ = keep_order;
+        if (keep_order) {
+            slot_of_rank_.assign(user_of_rank);
+            rank_of_slot_.assign(rank_of_user);
+        }
+        set_layers(grid);
+        set_wall_ranks();
     }
 
 private:
+    /// A host copy of the first n elements of policy memory.
+    template <class T>
+    static std::vector<T> buffer_copy(const T* data, std::size_t n)
+    {
+        buffer<T, Policy> b(n);
+        for_each_index(Policy{}, n, detail::copy_back<T>{data, b.data()});
+        return b.to_host();
+    }
+
+    void set_wall_ranks()
+    {
+        const std::size_t n = size();
+        buffer<unsigned, Policy> place(n + 1, 0u);
+        for_each_index(Policy{}, n, detail::has_walls{offset_.data(), partner_.data(), place.data()});
+        wall_particles_ = exclusive_scan_in_place(Policy{}, place.data(), n + 1);
+        wall_ranks_.resize(wall_particles_);
+        for_each_index(Policy{}, n,
+                       detail::list_wall_ranks{place.data(), wall_ranks_.data()});
+    }
+
+    void set_layers(const grid_view<Coord>& grid)
+    {
+        const grid_geometry<Coord>& g = grid.geometry;
+        const std::size_t layers = g.layers(), per_layer = g.cells_per_layer();
+        const std::vector<unsigned> starts = buffer_copy(grid.cell_start, g.cell_count() + 1);
+        const std::vector<unsigned> off = offset_.to_host();
+        layer_start_.resize(layers + 1);
+        layer_entries_.resize(layers + 1);
+        for (std::size_t l = 0; l <= layers; ++l) {
+            layer_start_[l] = starts[l * per_layer];
+            layer_entries_[l] = off[layer_start_[l]];
+        }
+        periodic_layers_ = g.box.periodic(g.slow);
+    }
+
     bool record_forces_ = true;
+    bool keep_order_ = false;
+    bool periodic_layers_ = false;
     std::size_t entries_ = 0;
     buffer<unsigned, Policy> offset_, partner_;
     buffer<vec4<Real>, Policy> history_, force_;
-    buffer<unsigned, Policy> new_offset_, new_partner_, key_;
-    buffer<vec4<Real>, Policy> new_history_;
+    buffer<unsigned, Policy> slot_of_rank_, rank_of_slot_; ///< only with keep_order
+    buffer<unsigned, Policy> wall_ranks_;
+    std::size_t wall_particles_ = 0;
+    std::vector<unsigned> layer_start_, layer_entries_;
 };
 
 } // namespace sphere

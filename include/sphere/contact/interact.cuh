@@ -1,168 +1,403 @@
 #pragma once
 /// \file
-/// The interaction kernel: each particle gathers the forces and torques of its listed
-/// partners and walls, with no atomics, so results are deterministic. Each pair is evaluated
-/// from both sides; each side books half of the pair's dissipation. Dashpots see the
-/// velocities at the time of the positions (v_sync, omega_sync); tangential springs follow the
-/// displacement of the last step (v, omega times dt: the velocities that moved the positions).
-///
-/// Two compile-time switches drop work that nothing reads: `Book` (the per-particle pressure,
-/// dissipation rates and dissipated energies of the energy audit) and `Record` (each entry's
-/// force, for the stress and contact-network analyses). The simulation picks them from its
-/// settings. A third, `OneVelocity`, says that the dashpots' velocities are the ones that moved
-/// the positions (velocity Verlet): the step's displacement is then the contact velocity times
-/// dt, and v, omega are not read a second time.
-#include <cmath>
+/// The interaction: every listed pair contact evaluated once (contact/evaluate.cuh) and its
+/// force and torques summed into both particles, by one of two schedules
+/// (contact/summation.cuh). Each particle's sum follows an order fixed by the contact lists
+/// (ranks and grid layers, contact/contact_lists.cuh), so results are bit-identical for any
+/// thread count and storage order. Walls are evaluated afterwards, per particle, with the
+/// integration (simulation.cuh).
 #include <cstddef>
-#include <type_traits>
+#include <vector>
 
-#include "../boundary/walls.cuh"
-#include "../boundary/world.cuh"
-#include "../core/constants.cuh"
-#include "../particles/state.cuh"
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+#include "../core/error.cuh"
+#include "../exec/algorithms.cuh"
+#include "../exec/buffer.cuh"
+#include "../exec/for_each.cuh"
+#include "../exec/policy.cuh"
 #include "contact_lists.cuh"
-#include "params.cuh"
-#include "result.cuh"
+#include "evaluate.cuh"
+#include "summation.cuh"
 
 namespace sphere {
 namespace detail {
 
-/// The particles' forces on the six wall faces, along each face's axis (N), summed in double.
-struct wall_loads {
-    double force[6];
-    SPHERE_HD wall_loads operator+(const wall_loads& b) const
+/// Zeroes what the pair sums accumulate into: force, torque and, with Book, the audit sums.
+template <class P, bool Book>
+struct zero_pair_sums {
+    particle_view<P> p;
+    SPHERE_HDI void operator()(std::size_t i) const
     {
-        wall_loads out;
-        for (int f = 0; f < 6; ++f) out.force[f] = force[f] + b.force[f];
-        return out;
+        using Real = real_t<P>;
+        p.force[i] = vec3<Real>{0, 0, 0};
+        p.torque[i] = vec3<Real>{0, 0, 0};
+        if (Book) {
+            p.pressure[i] = 0;
+            p.p_visc[i] = 0;
+            p.p_fric[i] = 0;
+        }
     }
 };
 
-/// The normal overlap-distance delta_n = |d| - reach (m, negative in contact) from a
-/// separation d, its squared length dist2 and the sum of radii, and the unit normal d / |d|.
-/// When positions are held in a wider type than the contact law's (precision mixed), the
-/// difference dist2 - reach^2 is formed in that type and divided by |d| + reach in the narrow
-/// one: the overlap keeps its relative precision although |d| and reach agree to 1e-5.
-template <class Real, class Coord>
-SPHERE_HDI Real overlap_and_normal(const vec3<Coord>& d, Coord dist2, Coord reach, vec3<Real>& n)
+/// A tile of pair contacts evaluated together in SIMD lanes: lanes [0, count) hold pairs,
+/// the rest repeat lane 0 and are discarded.
+template <class Real>
+struct pair_tile {
+    static constexpr int width = 16;
+    int count = 0;
+    unsigned owner[width], partner[width], entry[width];
+    Real fx[width], fy[width], fz[width];
+    Real tix[width], tiy[width], tiz[width], tjx[width], tjy[width], tjz[width];
+    Real hx[width], hy[width], hz[width], hw[width];
+    Real fn[width], visc[width], fric[width];
+    Real rx[width], ry[width], rz[width], rw[width];
+};
+
+/// The pair sums of the host's slab schedule, for the owners of a range of ranks: pairs are
+/// gathered into tiles in row order, evaluated lane-parallel, then added to both particles in
+/// tile order (so each particle's sum has a fixed order).
+template <class P, class Law, bool Book, bool Record, bool OneVelocity>
+struct slab_pairs {
+    using Real = real_t<P>;
+    pair_contact<P, Law, OneVelocity> eval;
+    contact_view<Real> c;
+    bool update_history;
+
+    void operator()(unsigned first_rank, unsigned end_rank) const
+    {
+        pair_tile<Real> t;
+        for (unsigned r = first_rank; r < end_rank; ++r) {
+            const unsigned i = static_cast<unsigned>(c.slot(r)), end = c.offset[r + 1];
+            for (unsigned e = c.offset[r]; e < end; ++e) {
+                const unsigned j = c.partner[e];
+                if (j >= wall_partner_base) break; // walls come last in a row
+                t.owner[t.count] = i;
+                t.partner[t.count] = j;
+                t.entry[t.count] = e;
+                if (++t.count == pair_tile<Real>::width) flush(t);
+            }
+        }
+        if (t.count) flush(t);
+    }
+
+private:
+    void flush(pair_tile<Real>& t) const
+    {
+        constexpr int w = pair_tile<Real>::width;
+        for (int k = t.count; k < w; ++k) {
+            t.owner[k] = t.owner[0];
+            t.partner[k] = t.partner[0];
+            t.entry[k] = t.entry[0];
+        }
+        // Local copies: loop invariants the compiler can keep in registers.
+        pair_contact<P, Law, OneVelocity> pairs = eval;
+        const vec4<Real>* history = c.history;
+        SPHERE_VECTORISE_LOOP
+        for (int k = 0; k < w; ++k) {
+            vec4<Real> h = history[t.entry[k]];
+            pair_result<Real> r = pairs.template evaluate<true>(t.owner[k], t.partner[k], h);
+            t.fx[k] = r.force.x;
+            t.fy[k] = r.force.y;
+            t.fz[k] = r.force.z;
+            t.tix[k] = r.torque_i.x;
+            t.tiy[k] = r.torque_i.y;
+            t.tiz[k] = r.torque_i.z;
+            t.tjx[k] = r.torque_j.x;
+            t.tjy[k] = r.torque_j.y;
+            t.tjz[k] = r.torque_j.z;
+            t.hx[k] = h.x;
+            t.hy[k] = h.y;
+            t.hz[k] = h.z;
+            t.hw[k] = h.w;
+            if (Book) {
+                t.fn[k] = r.fn;
+                t.visc[k] = r.visc_rate / 2;
+                t.fric[k] = r.fric_rate / 2;
+            }
+            if (Record) {
+                t.rx[k] = r.record.x;
+                t.ry[k] = r.record.y;
+                t.rz[k] = r.record.z;
+                t.rw[k] = r.record.w;
+            }
+        }
+        const particle_view<P>& p = eval.p;
+        for (int k = 0; k < t.count; ++k) {
+            const unsigned i = t.owner[k], j = t.partner[k], e = t.entry[k];
+            if (update_history) c.history[e] = {t.hx[k], t.hy[k], t.hz[k], t.hw[k]};
+            if (Record) c.force[e] = {t.rx[k], t.ry[k], t.rz[k], t.rw[k]};
+            const vec3<Real> f{t.fx[k], t.fy[k], t.fz[k]};
+            p.force[i] += f;
+            p.force[j] -= f;
+            p.torque[i] += vec3<Real>{t.tix[k], t.tiy[k], t.tiz[k]};
+            p.torque[j] += vec3<Real>{t.tjx[k], t.tjy[k], t.tjz[k]};
+            if (Book) {
+                p.pressure[i] += t.fn[k];
+                p.pressure[j] += t.fn[k];
+                p.p_visc[i] += t.visc[k];
+                p.p_visc[j] += t.visc[k];
+                p.p_fric[i] += t.fric[k];
+                p.p_fric[j] += t.fric[k];
+            }
+        }
+        t.count = 0;
+    }
+};
+
+/// The two phases of the slab schedule: tasks of grid layers whose owners write disjoint sets
+/// of particles (the owners of layer l write layers l and l + 1). Phase 0 holds the even
+/// layers, phase 1 the odd ones; on a periodic axis with an odd number of layers the last
+/// layer (which writes the first) joins the task of layer 0.
+struct slab_phases {
+    struct task {
+        unsigned layer[2];
+        unsigned layers;
+        std::size_t weight; ///< entries in the task's rows
+    };
+    std::vector<task> phase[2];
+
+    slab_phases(const std::vector<unsigned>& layer_entries, bool periodic)
+    {
+        const unsigned n = static_cast<unsigned>(layer_entries.size() - 1);
+        const bool merge_last = periodic && n >= 3 && n % 2 == 1;
+        auto weight = [&](unsigned l) { return std::size_t(layer_entries[l + 1] - layer_entries[l]); };
+        for (unsigned l = 0; l < n; ++l) {
+            if (merge_last && l == n - 1) continue;
+            task t{{l, 0}, 1, weight(l)};
+            if (merge_last && l == 0) t = {{n - 1, 0}, 2, weight(n - 1) + weight(0)};
+            phase[l % 2].push_back(t);
+        }
+    }
+
+    /// Thread t's tasks of phase ph among `threads`: a contiguous range, balanced by weight
+    /// (tasks go to the thread whose share holds their middle).
+    void share(int ph, int t, int threads, std::size_t& first, std::size_t& end) const
+    {
+        const std::vector<task>& tasks = phase[ph];
+        std::size_t total = 0;
+        for (const task& k : tasks) total += k.weight;
+        first = end = tasks.size();
+        std::size_t before = 0;
+        for (std::size_t k = 0; k < tasks.size(); ++k) {
+            const double middle = double(before) + double(tasks[k].weight) / 2;
+            const int owner = total ? static_cast<int>(middle * threads / double(total)) : 0;
+            before += tasks[k].weight;
+            if (owner == t && first == tasks.size()) first = k;
+            if (owner > t) {
+                end = k;
+                return;
+            }
+        }
+    }
+};
+
+/// Runs the slab schedule on the host: zeroes the sums, then the two phases, each thread
+/// working through its share of a phase's tasks.
+template <class Pairs, class Zero>
+void sum_by_slabs(const Pairs& pairs, const Zero& zero, std::size_t n, const std::vector<unsigned>& layer_start,
+                  const slab_phases& phases)
 {
-    if constexpr (std::is_same_v<Real, Coord>) {
-        const Real dist = std::sqrt(dist2);
-        n = d * (Real(1) / dist);
-        return dist - reach;
-    } else {
-        const Real dist = std::sqrt(Real(dist2));
-        n = vec_cast<Real>(d) * (Real(1) / dist);
-        return Real(dist2 - reach * reach) / (dist + Real(reach));
+    const long long count = static_cast<long long>(n);
+#pragma omp parallel if (n >= host_parallel_threshold)
+    {
+#ifdef _OPENMP
+        const int threads = omp_get_num_threads(), t = omp_get_thread_num();
+#else
+        const int threads = 1, t = 0;
+#endif
+#pragma omp for schedule(static)
+        for (long long i = 0; i < count; ++i) zero(static_cast<std::size_t>(i));
+        for (int ph = 0; ph < 2; ++ph) {
+            std::size_t first, end;
+            phases.share(ph, t, threads, first, end);
+            for (std::size_t k = first; k < end; ++k) {
+                const slab_phases::task& task = phases.phase[ph][k];
+                for (unsigned m = 0; m < task.layers; ++m)
+                    pairs(layer_start[task.layer[m]], layer_start[task.layer[m] + 1]);
+            }
+#pragma omp barrier
+        }
     }
 }
 
-/// Particle i's contacts: writes its force and torque (and what Book and Record ask for) and
-/// returns its share of the wall loads. P is the precision policy: positions, the world and
-/// the walls in coord_t<P>, everything the contact law sees in real_t<P>.
+/// The gather schedule, first pass (one index per rank): evaluates the owner's pairs and
+/// stores each pair's result.
 template <class P, class Law, bool Book, bool Record, bool OneVelocity>
-struct interact {
+struct evaluate_owned_pairs {
     using Real = real_t<P>;
-    using Coord = coord_t<P>;
-    particle_view<P> p;
+    pair_contact<P, Law, OneVelocity> eval;
     contact_view<Real> c;
-    world<Coord> box;
-    wall_set<Coord> walls;
-    contact_params<Real> pair_params;
-    contact_params<Real> wall_params;
-    Real dt;
-    bool update_history; ///< false for a force evaluation that must leave the contacts as they are
+    vec3<Real>* force;
+    vec3<Real>* torque_i;
+    vec3<Real>* torque_j;
+    vec3<Real>* audit; ///< |f_n|, half the viscous and half the frictional rate (Book only)
+    bool update_history;
 
-    SPHERE_HD wall_loads operator()(std::size_t i) const
+    SPHERE_HD void operator()(std::size_t r) const
     {
-        wall_loads loads{{0, 0, 0, 0, 0, 0}};
-        const vec4<Coord> xi = p.x[i];
-        const Real ri = Real(xi.w);
-        const vec3<Real> vi = p.v_sync[i], wi = p.omega_sync[i];
-        // the last step's motion (unused with OneVelocity)
-        const vec3<Real> si = OneVelocity ? vec3<Real>{0, 0, 0} : p.v[i] * dt;
-        const vec3<Real> ti = OneVelocity ? vec3<Real>{0, 0, 0} : p.omega[i] * dt;
-        const Real mi = p.mass[i];
-        vec3<Real> force{0, 0, 0}, torque{0, 0, 0};
-        Real fn_sum = 0, visc = 0, fric = 0;
-
-        const unsigned end = c.offset[i + 1];
-        for (unsigned e = c.offset[i]; e < end; ++e) {
+        const std::size_t i = c.slot(r);
+        const unsigned end = c.offset[r + 1];
+        for (unsigned e = c.offset[r]; e < end; ++e) {
             const unsigned j = c.partner[e];
+            if (j >= wall_partner_base) break;
             vec4<Real> h = c.history[e];
-            contact_result<Real> r;
-            Real arm;
-            vec3<Real> n;
-            bool touching;
-            if (j < wall_partner_base) {
-                const vec4<Coord> xj = p.x[j];
-                const vec3<Coord> d = box.nearest_image_inside(xi.xyz() - xj.xyz());
-                const Coord dist2 = norm2(d), reach = xi.w + xj.w;
-                touching = dist2 < reach * reach && dist2 > Coord(0);
-                if (touching) {
-                    const Real delta_n = overlap_and_normal(d, dist2, reach, n);
-                    arm = ri + delta_n / 2;
-                    const Real arm_j = Real(xj.w) + delta_n / 2;
-                    const Real mj = p.mass[j];
-                    contact_motion<Real> m;
-                    m.n = n;
-                    m.delta_n = delta_n;
-                    m.velocity = vi - p.v_sync[j] + arm * cross(n, wi) + arm_j * cross(n, p.omega_sync[j]);
-                    m.step = OneVelocity ? m.velocity * dt
-                                         : si - p.v[j] * dt + arm * cross(n, ti) + arm_j * cross(n, p.omega[j] * dt);
-                    m.m_eff = mi * mj / (mi + mj);
-                    r = Law::pair(pair_params, m, h, dt);
-                    r.visc_rate /= 2;
-                    r.fric_rate /= 2;
-                }
-            } else {
-                const int f = static_cast<int>(j - wall_partner_base);
-                const wall_face<Coord>& wall = walls.face[f];
-                const int a = f / 2;
-                n = wall_set<Real>::inward_normal(f);
-                const Coord dist_c = (xi.xyz()[a] - Coord(wall.position)) * Coord(n[a]);
-                const Real dist = Real(dist_c), delta_n = Real(dist_c - xi.w);
-                touching = delta_n < Real(0);
-                if (touching) {
-                    arm = dist;
-                    contact_motion<Real> m{n, delta_n, vi + dist * cross(n, wi), si + dist * cross(n, ti), mi};
-                    m.velocity[a] -= Real(wall.velocity);
-                    if (OneVelocity) m.step = m.velocity * dt;
-                    else m.step[a] -= Real(wall.velocity) * dt;
-                    r = Law::wall(wall_params, m, h, dt);
-                    loads.force[f] = -double(r.normal[a] + r.tangential[a]);
-                }
-            }
-            if (touching) {
-                force += r.normal + r.tangential;
-                torque -= arm * cross(n, r.tangential);
-                if (Book) {
-                    fn_sum += r.fn;
-                    visc += r.visc_rate;
-                    fric += r.fric_rate;
-                }
-                if (Record) c.force[e] = {r.tangential.x, r.tangential.y, r.tangential.z, dot(r.normal, n)};
-                if (update_history) c.history[e] = h;
-            } else {
-                if (Record) c.force[e] = vec4<Real>{0, 0, 0, 0};
-                // a contact that has ended forgets its history
-                if (update_history && (h.x != Real(0) || h.y != Real(0) || h.z != Real(0) || h.w != Real(0)))
-                    c.history[e] = vec4<Real>{0, 0, 0, 0};
-            }
+            pair_result<Real> res = eval.template evaluate<false>(i, j, h);
+            if (update_history) c.history[e] = h;
+            if (Record) c.force[e] = res.record;
+            force[e] = res.force;
+            torque_i[e] = res.torque_i;
+            torque_j[e] = res.torque_j;
+            if (Book) audit[e] = {res.fn, res.visc_rate / 2, res.fric_rate / 2};
         }
-
-        p.force[i] = force;
-        p.torque[i] = torque;
-        if (Book && update_history) {
-            p.pressure[i] = fn_sum / (4 * pi<Real> * ri * ri);
-            p.p_visc[i] = visc;
-            p.p_fric[i] = fric;
-            p.e_visc[i] += visc * dt;
-            p.e_fric[i] += fric * dt;
-        }
-        return loads;
     }
 };
 
+/// The gather schedule, second pass (one index per slot): the particle's own pairs, then the
+/// pairs that list it as partner (in their owners' rank order).
+template <class P, bool Book>
+struct gather_pair_results {
+    using Real = real_t<P>;
+    particle_view<P> p;
+    contact_view<Real> c;
+    const unsigned* reverse_offset; ///< pairs whose partner has rank r: reverse_entry[reverse_offset[r] ...]
+    const unsigned* reverse_entry;
+    const vec3<Real>* force;
+    const vec3<Real>* torque_i;
+    const vec3<Real>* torque_j;
+    const vec3<Real>* audit;
+
+    SPHERE_HD void operator()(std::size_t s) const
+    {
+        const std::size_t r = c.rank(s);
+        vec3<Real> f{0, 0, 0}, t{0, 0, 0}, a{0, 0, 0};
+        const unsigned end = c.offset[r + 1];
+        for (unsigned e = c.offset[r]; e < end && c.partner[e] < wall_partner_base; ++e) {
+            f += force[e];
+            t += torque_i[e];
+            if (Book) a += audit[e];
+        }
+        for (unsigned m = reverse_offset[r]; m < reverse_offset[r + 1]; ++m) {
+            const unsigned e = reverse_entry[m];
+            f -= force[e];
+            t += torque_j[e];
+            if (Book) a += audit[e];
+        }
+        p.force[s] = f;
+        p.torque[s] = t;
+        if (Book) {
+            p.pressure[s] = a.x;
+            p.p_visc[s] = a.y;
+            p.p_fric[s] = a.z;
+        }
+    }
+};
+
+/// The sort key of each entry for the reverse index: its partner's rank, or ~0 for a wall.
+template <class Real>
+struct reverse_keys {
+    contact_view<Real> c;
+    unsigned* key;
+    unsigned* entry;
+    SPHERE_HD void operator()(std::size_t e) const
+    {
+        const unsigned j = c.partner[e];
+        key[e] = j < wall_partner_base ? static_cast<unsigned>(c.rank(j)) : ~0u;
+        entry[e] = static_cast<unsigned>(e);
+    }
+};
+
+/// From keys sorted ascending (values up to n, larger ones counted as n), start[v] = the first
+/// position whose key is at least v, for v = 0 .. n (one index per position and one past the end).
+struct key_starts {
+    std::size_t count, n;
+    const unsigned* key;
+    unsigned* start;
+    SPHERE_HD void operator()(std::size_t k) const
+    {
+        const std::size_t first = k == 0 ? 0 : clamp(key[k - 1]) + 1;
+        const std::size_t last = k == count ? n : clamp(key[k]);
+        for (std::size_t v = first; v <= last; ++v) start[v] = static_cast<unsigned>(k);
+    }
+    SPHERE_HD std::size_t clamp(unsigned v) const { return v < n ? v : n; }
+};
+
 } // namespace detail
+
+/// Sums the pair contacts into the particles' forces and torques (and, with Book, their audit
+/// sums), by the chosen schedule; owns the gather schedule's scratch.
+template <class P, class Policy>
+class interaction {
+public:
+    using Real = real_t<P>;
+    using Coord = coord_t<P>;
+
+    /// The schedule `how` resolves to on this backend; throws for slabs on CUDA.
+    static pair_summation resolve(pair_summation how)
+    {
+        constexpr bool on_host = std::is_same_v<Policy, host>;
+        if (how == pair_summation::automatic) return on_host ? pair_summation::slabs : pair_summation::gather;
+        if (how == pair_summation::slabs && !on_host)
+            detail::fail("settings.pair_summation = slabs needs the host backend; use gather (or automatic) on CUDA");
+        if (how != pair_summation::slabs && how != pair_summation::gather)
+            detail::fail("settings.pair_summation = ", unsigned(how), ": not a pair_summation");
+        return how;
+    }
+
+    /// The contact lists were rebuilt or replaced.
+    void lists_changed() { reverse_ready_ = false; }
+
+    /// Overwrites every particle's force and torque (and, with Book, its |f_n| sum and
+    /// dissipation rates) with the sums over its pair contacts. Book implies update_history.
+    template <bool Book, bool Record, class Law, bool OneVelocity>
+    void sum_pairs(const detail::pair_contact<P, Law, OneVelocity>& eval, contact_lists<P, Policy>& lists,
+                   pair_summation how, bool update_history)
+    {
+        const particle_view<P>& p = eval.p;
+        const contact_view<Real> c = lists.view();
+        if (resolve(how) == pair_summation::slabs) {
+            if constexpr (std::is_same_v<Policy, host>) {
+                const detail::slab_phases phases(lists.layer_entries(), lists.periodic_layers());
+                detail::sum_by_slabs(detail::slab_pairs<P, Law, Book, Record, OneVelocity>{eval, c, update_history},
+                                     detail::zero_pair_sums<P, Book>{p}, p.n, lists.layer_start(), phases);
+            }
+            return;
+        }
+        const std::size_t entries = lists.entries();
+        if (force_.size() < entries) {
+            force_.resize(entries);
+            torque_i_.resize(entries);
+            torque_j_.resize(entries);
+        }
+        if (Book && audit_.size() < entries) audit_.resize(entries);
+        if (!reverse_ready_) build_reverse(c, entries, p.n);
+        for_each_index(Policy{}, p.n,
+                       detail::evaluate_owned_pairs<P, Law, Book, Record, OneVelocity>{
+                           eval, c, force_.data(), torque_i_.data(), torque_j_.data(), Book ? audit_.data() : nullptr,
+                           update_history});
+        for_each_index(Policy{}, p.n,
+                       detail::gather_pair_results<P, Book>{p, c, reverse_offset_.data(), reverse_entry_.data(),
+                                                            force_.data(), torque_i_.data(), torque_j_.data(),
+                                                            Book ? audit_.data() : nullptr});
+    }
+
+private:
+    void build_reverse(const contact_view<Real>& c, std::size_t entries, std::size_t n)
+    {
+        buffer<unsigned, Policy> key(entries);
+        reverse_entry_.resize(entries);
+        reverse_offset_.resize(n + 1);
+        for_each_index(Policy{}, entries, detail::reverse_keys<Real>{c, key.data(), reverse_entry_.data()});
+        sort_by_key(Policy{}, key.data(), reverse_entry_.data(), entries);
+        for_each_index(Policy{}, entries + 1, detail::key_starts{entries, n, key.data(), reverse_offset_.data()});
+        reverse_ready_ = true;
+    }
+
+    buffer<vec3<Real>, Policy> force_, torque_i_, torque_j_, audit_;
+    buffer<unsigned, Policy> reverse_offset_, reverse_entry_;
+    bool reverse_ready_ = false;
+};
+
 } // namespace sphere

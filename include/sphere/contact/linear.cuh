@@ -31,9 +31,12 @@ template <class Real>
 SPHERE_HDI normal_force<Real> linear_normal(const contact_params<Real>& p, Real delta_n, Real ddelta_n)
 {
     const Real elastic = -p.k_n * delta_n;
-    Real f = elastic - p.gamma_n * ddelta_n;
-    if (!p.tension && f < Real(0)) f = 0;
-    return {f, -(f - elastic) * ddelta_n};
+    const Real trial = elastic - p.gamma_n * ddelta_n;
+    const bool clipped = !p.tension && trial < Real(0);
+    // -(f - elastic) d(delta_n)/dt, written per case so that it is exactly zero without
+    // damping whatever the compiler contracts into fused multiply-adds
+    const Real visc = clipped ? elastic * ddelta_n : p.gamma_n * ddelta_n * ddelta_n;
+    return {clipped ? Real(0) : trial, visc};
 }
 
 /// The linear contact law. `PairTangential` and `WallTangential` are tangential policies
@@ -91,17 +94,17 @@ private:
                                                    vec4<Real>& h, Real dt)
     {
         contact_params<Real> p = given;
-        if (p.damping == damping_convention::mass_scaled) { // gamma in 1/s: c = gamma m_eff (N s/m)
-            p.gamma_n *= m.m_eff;
-            p.gamma_t *= m.m_eff;
-        }
+        // gamma in 1/s when mass-scaled: c = gamma m_eff (N s/m)
+        const Real scale = p.damping == damping_convention::mass_scaled ? m.m_eff : Real(1);
+        p.gamma_n *= scale;
+        p.gamma_t *= scale;
         const vec3<Real>& n = m.n;
         const Real ddelta_n = dot(m.velocity, n);
-        const normal_force<Real> fn = linear_normal(p, m.delta_n, ddelta_n);
+        normal_force<Real> fn = linear_normal(p, m.delta_n, ddelta_n);
         const vec3<Real> vt = m.velocity - n * ddelta_n;
         const vec3<Real> step_t = m.step - n * dot(m.step, n);
         const Real fn_abs = fn.magnitude < Real(0) ? -fn.magnitude : fn.magnitude; // < 0 only with tension
-        const tangential_force<Real> ft = Tangential::evaluate(p, n, vt, step_t, fn_abs, h, dt);
+        tangential_force<Real> ft = Tangential::evaluate(p, n, vt, step_t, fn_abs, h, dt);
         contact_result<Real> out;
         out.normal = n * fn.magnitude;
         out.tangential = ft.force;

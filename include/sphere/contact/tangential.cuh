@@ -34,21 +34,19 @@ struct visco_frictional {
                                                      const vec3<Real>& vt, const vec3<Real>& /*step_t*/, Real fn,
                                                      vec4<Real>& h, Real /*dt*/)
     {
+        // Written without branches (selects), so that a loop over contacts vectorises.
         tangential_force<Real> out;
-        out.force = -p.gamma_t * vt;
-        const Real ft2 = norm2(out.force);
+        const vec3<Real> trial = -p.gamma_t * vt;
+        const Real ft2 = norm2(trial);
         const bool was_sliding = h.w != Real(0);
         const Real limit = (was_sliding ? p.mu_d : p.mu_s) * fn;
-        if (ft2 > limit * limit) {
-            const Real ft = std::sqrt(ft2);
-            const Real slide_limit = p.mu_d * fn;
-            out.force = out.force * (slide_limit / ft);
-            out.fric_rate = slide_limit * norm(vt);
-            h.w = 1;
-        } else {
-            out.visc_rate = p.gamma_t * norm2(vt);
-            h.w = 0;
-        }
+        const bool slides = ft2 > limit * limit;
+        const Real slide_limit = p.mu_d * fn;
+        const Real scale = slide_limit / std::sqrt(slides ? ft2 : Real(1));
+        out.force = select(slides, trial * scale, trial);
+        out.fric_rate = slides ? slide_limit * norm(vt) : Real(0);
+        out.visc_rate = slides ? Real(0) : p.gamma_t * norm2(vt);
+        h.w = slides ? Real(1) : Real(0);
         return out;
     }
 
@@ -60,11 +58,12 @@ struct visco_frictional {
 /// (incremented by the contact point's tangential displacement in each step), kept in the
 /// current contact plane (projected and rescaled to its length, so a rigid
 /// rotation of the pair rotates it without shrinking it). At the Coulomb limit the
-/// displacement is rescaled so that f_t = mu_d |f_n| t_hat:
-/// delta_t = -(mu_d |f_n| t_hat + gamma_t v_t) / k_t (VALIDATION pitfall 4: note the sign).
-/// Sticking, the dashpot dissipates gamma_t |v_t|^2; sliding, the contact dissipates the power
-/// -f_t . v_t it takes from the motion less the change of the spring's energy, so the energy
-/// budget closes whatever gamma_t is.
+/// displacement is set so that the spring alone carries the sliding force:
+/// f_t = mu_d |f_n| t_hat and delta_t = -mu_d |f_n| t_hat / k_t (docs/physics.md, "Tangential
+/// force", on why the dashpot force is left out). Sticking, the dashpot dissipates
+/// gamma_t |v_t|^2; sliding, the contact dissipates the power -f_t . v_t it takes from the
+/// motion less the change of the spring's energy, so the energy budget closes whatever
+/// gamma_t is.
 struct elastic_viscous_frictional {
     template <class Real>
     static void validate(const contact_params<Real>& p, const char* where)
@@ -78,39 +77,34 @@ struct elastic_viscous_frictional {
                                                      const vec3<Real>& vt, const vec3<Real>& step_t, Real fn,
                                                      vec4<Real>& h, Real dt)
     {
+        // Written without branches (selects, divisions by guarded denominators), so that a
+        // loop over contacts vectorises.
         tangential_force<Real> out;
-        // Carry the displacement into the current contact plane, keeping its length.
-        vec3<Real> d{h.x, h.y, h.z};
-        vec3<Real> before{0, 0, 0};
-        const Real len2 = norm2(d);
-        if (len2 > Real(0)) { // a new contact has no displacement to carry
-            d -= n * dot(n, d);
-            const Real in_plane2 = norm2(d);
-            if (in_plane2 > Real(0)) before = d * std::sqrt(len2 / in_plane2);
-        }
-        d = before + step_t; // the spring follows the contact point's actual motion
+        // Carry the displacement into the current contact plane, keeping its length; a new
+        // contact has none to carry.
+        const vec3<Real> d{h.x, h.y, h.z};
+        const vec3<Real> in_plane = d - n * dot(n, d);
+        const Real len2 = norm2(d), in_plane2 = norm2(in_plane);
+        const bool carried = len2 > Real(0) && in_plane2 > Real(0);
+        const Real stretch = std::sqrt(len2 / (carried ? in_plane2 : Real(1)));
+        vec3<Real> before = select(carried, in_plane * stretch, vec3<Real>{0, 0, 0});
+        const vec3<Real> spring = before + step_t; // the spring follows the contact point's actual motion
 
-        out.force = -p.k_t * d - p.gamma_t * vt;
-        const Real ft2 = norm2(out.force);
+        const vec3<Real> trial = -p.k_t * spring - p.gamma_t * vt;
+        const Real ft2 = norm2(trial);
         const bool was_sliding = h.w != Real(0);
         const Real limit = (was_sliding ? p.mu_d : p.mu_s) * fn;
-        if (ft2 > limit * limit) {
-            const Real ft = std::sqrt(ft2);
-            const Real slide_limit = p.mu_d * fn;
-            const vec3<Real> t_hat = out.force / ft;
-            const vec3<Real> slid = -(slide_limit / p.k_t) * t_hat;
-            out.force = slide_limit * t_hat;
-            // Sliding: the power taken from the motion, -f_t . v_t, less what the spring stored.
-            out.fric_rate = -dot(out.force, vt) - Real(0.5) * p.k_t * (norm2(slid) - norm2(before)) / dt;
-            d = slid;
-            h.w = 1;
-        } else {
-            out.visc_rate = p.gamma_t * norm2(vt);
-            h.w = 0;
-        }
-        h.x = d.x;
-        h.y = d.y;
-        h.z = d.z;
+        const bool slides = ft2 > limit * limit;
+        const Real slide_limit = p.mu_d * fn;
+        const vec3<Real> t_hat = trial / std::sqrt(slides ? ft2 : Real(1));
+        const vec3<Real> slid = -(slide_limit / p.k_t) * t_hat;
+        out.force = select(slides, slide_limit * t_hat, trial);
+        // Sliding: the power taken from the motion, -f_t . v_t, less what the spring stored.
+        out.fric_rate =
+            slides ? -dot(out.force, vt) - Real(0.5) * p.k_t * (norm2(slid) - norm2(before)) / dt : Real(0);
+        out.visc_rate = slides ? Real(0) : p.gamma_t * norm2(vt);
+        vec3<Real> kept = select(slides, slid, spring);
+        h = {kept.x, kept.y, kept.z, slides ? Real(1) : Real(0)};
         return out;
     }
 

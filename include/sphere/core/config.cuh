@@ -25,6 +25,15 @@
 #define SPHERE_HDI inline
 #endif
 
+/// SPHERE_VECTORISE_LOOP before a loop whose iterations are independent: vectorise it. g++ is
+/// told `ivdep` (its `omp simd` privatises a loop's local structs into arrays, which it then
+/// cannot vectorise); other compilers `omp simd`.
+#if defined(__GNUC__) && !defined(__clang__)
+#define SPHERE_VECTORISE_LOOP _Pragma("GCC ivdep")
+#else
+#define SPHERE_VECTORISE_LOOP _Pragma("omp simd")
+#endif
+
 #if defined(__CUDA_ARCH__)
 #define SPHERE_DEVICE_CODE 1
 #else

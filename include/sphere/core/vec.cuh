@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "config.cuh"
+#include "constants.cuh"
 
 namespace sphere {
 
@@ -49,9 +50,22 @@ template <class Real> SPHERE_HDI vec3<Real> cross(const vec3<Real>& a, const vec
 template <class Real> SPHERE_HDI Real norm2(const vec3<Real>& a) { return dot(a, a); }
 template <class Real> SPHERE_HDI Real norm(const vec3<Real>& a) { return std::sqrt(dot(a, a)); }
 
+/// c ? a : b, component by component: unlike the conditional operator on whole vectors
+/// (a conditional copy in memory), a select that a loop over contacts can vectorise.
+template <class Real> SPHERE_HDI vec3<Real> select(bool c, const vec3<Real>& a, const vec3<Real>& b)
+{
+    return {c ? a.x : b.x, c ? a.y : b.y, c ? a.z : b.z};
+}
+template <class Real> SPHERE_HDI vec4<Real> select(bool c, const vec4<Real>& a, const vec4<Real>& b)
+{
+    return {c ? a.x : b.x, c ? a.y : b.y, c ? a.z : b.z, c ? a.w : b.w};
+}
+
+/// Whether every component is finite; without branches (|c| <= max is false for inf and NaN).
 template <class Real> SPHERE_HDI bool isfinite(const vec3<Real>& a)
 {
-    return std::isfinite(a.x) && std::isfinite(a.y) && std::isfinite(a.z);
+    const Real big = largest<Real>;
+    return (std::fabs(a.x) <= big) & (std::fabs(a.y) <= big) & (std::fabs(a.z) <= big);
 }
 
 /// Converts between precisions (e.g. a double vector from user input to the simulation's Real).

@@ -4,9 +4,10 @@
 /// `sort_by_key` (stable, so equal keys keep their order and results are deterministic) and
 /// `transform_reduce` over an index range.
 ///
-/// Host reductions sum fixed chunks of 512 indices and then the chunk results in order,
+/// Host reductions sum fixed chunks of host_chunk indices and then the chunk results in order,
 /// so a floating-point sum is bit-identical for any number of OpenMP threads.
 #include <cstddef>
+#include <type_traits>
 #include <vector>
 
 #include <thrust/sort.h>
@@ -60,20 +61,30 @@ inline std::size_t exclusive_scan_in_place(host, unsigned* values, std::size_t n
     return sum;
 }
 
-/// Returns init op f(0) op f(1) ... op f(n-1), in a fixed association order.
+/// Returns init op f(0) op f(1) ... op f(n-1), in a fixed association order: in order within
+/// chunks of host_chunk indices (small enough to share n = 1e4 evenly between threads), then
+/// the chunks in order. For a number type T the values of a chunk are computed first, in a
+/// loop that may vectorise, and then combined in order.
 template <class T, class Transform, class Op>
 T transform_reduce(host, std::size_t n, const Transform& f, T init, Op op)
 {
-    constexpr std::size_t chunk = 512; // small enough to share n = 1e4 evenly between threads
-    const std::size_t chunks = (n + chunk - 1) / chunk;
+    const std::size_t chunks = (n + host_chunk - 1) / host_chunk;
     std::vector<T> partial(chunks, init);
     const long long count = static_cast<long long>(chunks);
 #pragma omp parallel for schedule(static) if (chunks > 1)
     for (long long c = 0; c < count; ++c) {
-        const std::size_t begin = static_cast<std::size_t>(c) * chunk;
-        const std::size_t end = begin + chunk < n ? begin + chunk : n;
-        T acc = f(begin);
-        for (std::size_t i = begin + 1; i < end; ++i) acc = op(acc, f(i));
+        Transform local = f; // see detail::run_chunk
+        const std::size_t begin = static_cast<std::size_t>(c) * host_chunk;
+        const std::size_t end = begin + host_chunk < n ? begin + host_chunk : n;
+        T acc = local(begin);
+        if constexpr (std::is_arithmetic_v<T>) {
+            T values[host_chunk];
+            SPHERE_VECTORISE_LOOP
+            for (std::size_t i = begin + 1; i < end; ++i) values[i - begin] = local(i);
+            for (std::size_t i = begin + 1; i < end; ++i) acc = op(acc, values[i - begin]);
+        } else {
+            for (std::size_t i = begin + 1; i < end; ++i) acc = op(acc, local(i));
+        }
         partial[static_cast<std::size_t>(c)] = acc;
     }
     T result = init;

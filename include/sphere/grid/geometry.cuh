@@ -13,13 +13,23 @@ namespace sphere {
 /// A uniform grid of n[0] x n[1] x n[2] cells covering the world box. Cells are at least as
 /// wide as the contact search reach (largest diameter plus skin), so every candidate pair lies
 /// in the same or an adjacent cell.
+///
+/// Cells are numbered with axis `fast` varying fastest and axis `slow` slowest (by default x
+/// fastest, z slowest). The contact grid (`make`) makes the axis with the most cells the slow
+/// one: its layers of cells are the slabs of the host interaction (contact/interact.cuh), and
+/// particles stored in cell order then lie slab after slab in memory.
 template <class Real>
 struct grid_geometry {
     world<Real> box;
     vec3<Real> width{0, 0, 0}; ///< cell widths (m)
     unsigned n[3] = {1, 1, 1};
+    int fast = 0, mid = 1, slow = 2; ///< axes in the order of the cell numbering
 
     SPHERE_HD std::size_t cell_count() const { return std::size_t(n[0]) * n[1] * n[2]; }
+    /// Cells in one layer across the slow axis.
+    SPHERE_HD unsigned cells_per_layer() const { return n[fast] * n[mid]; }
+    /// Layers along the slow axis.
+    SPHERE_HD unsigned layers() const { return n[slow]; }
 
     /// Cell coordinate of c along axis a, clamped into the grid.
     SPHERE_HD int coordinate(Real c, int a) const
@@ -30,9 +40,16 @@ struct grid_geometry {
         return static_cast<int>(f);
     }
 
+    /// The number of the cell with coordinates c[0], c[1], c[2] along x, y, z.
+    SPHERE_HD unsigned index(const int c[3]) const
+    {
+        return (static_cast<unsigned>(c[slow]) * n[mid] + static_cast<unsigned>(c[mid])) * n[fast] +
+               static_cast<unsigned>(c[fast]);
+    }
     SPHERE_HD unsigned index(int ix, int iy, int iz) const
     {
-        return (static_cast<unsigned>(iz) * n[1] + static_cast<unsigned>(iy)) * n[0] + static_cast<unsigned>(ix);
+        const int c[3] = {ix, iy, iz};
+        return index(c);
     }
 
     SPHERE_HD unsigned cell_of(const vec3<Real>& p) const
@@ -41,9 +58,11 @@ struct grid_geometry {
     }
 
     /// Lays a grid over `box` with cells at least `reach` (m) wide, or exactly `requested` wide
-    /// per axis when it is positive (rounded down to fit the box). Throws when a requested cell
-    /// is narrower than `reach`, when a periodic axis has fewer than 3 cells, or when the grid
-    /// would exceed 2^28 cells.
+    /// per axis when it is positive (rounded down to fit the box). The axis with the most cells
+    /// (the first of equals) is numbered slowest; of the other two, a wall axis is numbered
+    /// fastest when the other is periodic (a run of cells along it never wraps), else the
+    /// lower one. Throws when a requested cell is narrower than `reach`, when a periodic axis
+    /// has fewer than 3 cells, or when the grid would exceed 2^28 cells.
     static grid_geometry make(const world<Real>& box, Real reach, Real requested)
     {
         if (requested > 0 && requested < reach)
@@ -61,6 +80,13 @@ struct grid_geometry {
                              " grid cells of at least ", target,
                              " m: a periodic axis needs at least 3 (make the world wider or the particles smaller)");
         }
+        g.slow = 0;
+        for (int a = 1; a < 3; ++a)
+            if (g.n[a] > g.n[g.slow]) g.slow = a;
+        const int other[2] = {g.slow == 0 ? 1 : 0, g.slow == 2 ? 1 : 2};
+        const bool swap = box.periodic(other[0]) && !box.periodic(other[1]);
+        g.fast = swap ? other[1] : other[0];
+        g.mid = swap ? other[0] : other[1];
         if (g.cell_count() > (std::size_t(1) << 28))
             detail::fail("the neighbour grid would need ", g.cell_count(), " cells (", g.n[0], " x ", g.n[1], " x ",
                          g.n[2], "); set settings.cell_size larger or shrink the world");

@@ -1,7 +1,9 @@
 #pragma once
 /// \file
-/// The uniform neighbour grid: hash each particle to its cell, sort by cell (stable),
-/// gather positions in cell order and find where each cell starts in the sorted order.
+/// The uniform neighbour grid: hash each particle to its cell, sort by cell (ties by the
+/// particle's user index, so the order depends on positions and user indices alone, not on
+/// where the particles are stored), gather positions in cell order and find where each cell
+/// starts in the sorted order.
 #include <cstddef>
 #include <type_traits>
 
@@ -26,15 +28,19 @@ struct grid_view {
 };
 
 namespace detail {
+/// Sort key of slot i: its cell in the high 32 bits, its user index (or its slot when the
+/// view has no user indices) in the low ones.
 template <class Real>
 struct hash_particles {
     grid_geometry<Real> g;
     const vec4<Real>* x;
-    unsigned* key;
+    const unsigned* user; ///< may be null
+    unsigned long long* key;
     unsigned* order;
     SPHERE_HD void operator()(std::size_t i) const
     {
-        key[i] = g.cell_of(x[i].xyz());
+        const unsigned tie = user ? user[i] : static_cast<unsigned>(i);
+        key[i] = (static_cast<unsigned long long>(g.cell_of(x[i].xyz())) << 32) | tie;
         order[i] = static_cast<unsigned>(i);
     }
 };
@@ -46,15 +52,15 @@ template <class Real>
 struct find_cell_starts {
     std::size_t n;
     std::size_t cells;
-    const unsigned* key;
+    const unsigned long long* key;
     const unsigned* order;
     const vec4<Real>* x;
     vec4<Real>* sorted_x;
     unsigned* cell_start;
     SPHERE_HD void operator()(std::size_t k) const
     {
-        const std::size_t first = k == 0 ? 0 : std::size_t(key[k - 1]) + 1;
-        const std::size_t last = k == n ? cells : std::size_t(key[k]);
+        const std::size_t first = k == 0 ? 0 : std::size_t(key[k - 1] >> 32) + 1;
+        const std::size_t last = k == n ? cells : std::size_t(key[k] >> 32);
         for (std::size_t c = first; c <= last; ++c) cell_start[c] = static_cast<unsigned>(k);
         if (k < n) sorted_x[k] = x[order[k]];
     }
@@ -81,7 +87,7 @@ public:
             sorted_x_.resize(p.n);
         }
         if (cell_start_.size() != cells + 1) cell_start_.resize(cells + 1);
-        for_each_index(Policy{}, p.n, detail::hash_particles<Real>{geometry_, p.x, key_.data(), order_.data()});
+        for_each_index(Policy{}, p.n, detail::hash_particles<Real>{geometry_, p.x, p.user, key_.data(), order_.data()});
         sort_by_key(Policy{}, key_.data(), order_.data(), p.n);
         for_each_index(Policy{}, p.n + 1,
                        detail::find_cell_starts<Real>{p.n, cells, key_.data(), order_.data(), p.x, sorted_x_.data(),
@@ -100,7 +106,8 @@ public:
 
 private:
     grid_geometry<Real> geometry_;
-    buffer<unsigned, Policy> key_, order_, cell_start_;
+    buffer<unsigned long long, Policy> key_;
+    buffer<unsigned, Policy> order_, cell_start_;
     buffer<vec4<Real>, Policy> sorted_x_;
 };
 

@@ -1,28 +1,60 @@
 #pragma once
 /// \file
-/// The integration kernel and the post-step check of every particle.
+/// The integration kernels and the post-step check of every particle. The bodies are written
+/// with selects instead of branches (on the motion kind, the periodic axes, the check), so
+/// that the host's loop over particles vectorises.
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
 
 #include "../boundary/walls.cuh"
 #include "../boundary/world.cuh"
+#include "../core/constants.cuh"
 #include "../particles/state.cuh"
 
 namespace sphere {
 namespace detail {
 
-/// The accelerations of free particle i (m/s^2, rad/s^2) under its contact force, external
-/// force (when `external` is not null: the pore fluid's), torque (moment of inertia 2/5 m r^2)
-/// and gravity.
-template <class P, class Real = real_t<P>>
-SPHERE_HD void free_accelerations(const particle_view<P>& p, std::size_t i, const vec3<Real>& gravity,
-                                  const vec3<Real>* external, vec3<Real>& a, vec3<Real>& alpha)
+/// The accelerations of particle i (m/s^2, rad/s^2) by its motion kind: a free particle under
+/// its contact force, external force (`External`: the pore fluid's, from `external`), torque
+/// (moment of inertia 2/5 m r^2) and gravity; a horizontally prescribed one along z under its
+/// contact force alone; none for the others.
+///
+/// The kinds scale the forces by 1/m or by 0 rather than select between accelerations: every
+/// field is then loaded whatever the kind, which the compiler needs to vectorise the loop over
+/// particles (it cannot load a particle's fields conditionally in SIMD lanes). Forces are
+/// finite in any step the particle check lets through, so the zero scale gives exact zeros.
+template <bool External, class P, class Real = real_t<P>>
+SPHERE_HDI void accelerations(const particle_view<P>& p, std::size_t i, motion kind, const vec3<Real>& gravity,
+                              const vec3<Real>* external, vec3<Real>& a, vec3<Real>& alpha)
 {
     const Real m = p.mass[i], r = Real(p.x[i].w);
-    const vec3<Real> f = external ? p.force[i] + external[i] : p.force[i];
-    a = f / m + gravity;
-    alpha = p.torque[i] / (Real(0.4) * m * r * r);
+    vec3<Real> contact = p.force[i], total = contact; // not const: see the note in contact/evaluate.cuh
+    if constexpr (External) total += external[i];
+    const bool free = kind == motion::free, horizontal = kind == motion::prescribed_horizontal;
+    const Real inv_m = Real(1) / m;
+    const Real free_scale = free ? inv_m : Real(0);
+    const Real z_scale = free || horizontal ? inv_m : Real(0);
+    a.x = total.x * free_scale + (free ? gravity.x : Real(0));
+    a.y = total.y * free_scale + (free ? gravity.y : Real(0));
+    a.z = (free ? total.z : contact.z) * z_scale + (free ? gravity.z : Real(0));
+    alpha = p.torque[i] * (free ? Real(1) / (Real(0.4) * m * r * r) : Real(0));
+}
+
+/// A position wrapped into the box on its periodic axes (world::wrap, without branches).
+template <class Coord>
+SPHERE_HDI vec3<Coord> wrapped(const world<Coord>& box, const vec3<Coord>& x)
+{
+    vec3<Coord> out;
+    for (int a = 0; a < 3; ++a) {
+        const Coord c = x[a], lo = box.lo[a], hi = box.hi[a], l = hi - lo;
+        const bool inside = c >= lo && c < hi;
+        const Coord shifted = c - l * std::floor((c - lo) / l);
+        // round-off can land on hi or a hair below lo
+        const Coord back = shifted >= lo && shifted < hi ? shifted : lo;
+        out[a] = box.periodic(a) && std::isfinite(c) && !inside ? back : c;
+    }
+    return out;
 }
 
 /// Advances particle i by dt after the forces: free particles with the integrator policy,
@@ -31,7 +63,12 @@ SPHERE_HD void free_accelerations(const particle_view<P>& p, std::size_t i, cons
 /// stores the velocities at the new positions' time. Coordinates on periodic axes are wrapped
 /// back into the box. For an integrator that drifts before the forces, the drift has moved
 /// the particles already (drift_particles) and this is its second half kick.
-template <class P, class Integrator>
+///
+/// Every kind goes through the integrator with its own accelerations: zero for prescribed and
+/// fixed ones, whose velocities therefore stay (a fixed particle's are zero, so it stays where
+/// it is). No kind selects what is stored: the compiler would turn that into conditional loads
+/// and stores, which SIMD lanes cannot do.
+template <class P, class Integrator, bool External = false>
 struct integrate_particles {
     using Real = real_t<P>;
     using Coord = coord_t<P>;
@@ -39,49 +76,38 @@ struct integrate_particles {
     world<Coord> box;
     vec3<Real> gravity;
     Real dt;
-    const vec3<Real>* external; ///< external force on each particle (N), or null
+    const vec3<Real>* external; ///< external force on each particle (N), read with External
 
-    SPHERE_HD void operator()(std::size_t i) const
+    SPHERE_HDI void operator()(std::size_t i) const
     {
-        const auto kind = static_cast<motion>(p.kind[i]);
-        if (kind == motion::fixed) return;
-        const vec4<Coord> x = p.x[i];
-        vec3<Coord> pos = x.xyz();
-        vec3<Real> v = p.v[i], w = p.omega[i], ang = p.angpos[i];
-        vec3<Real> v_sync = v, w_sync = w;
         constexpr bool drifted = Integrator::drifts_before_forces;
-        if (kind == motion::free) {
-            vec3<Real> a, alpha;
-            free_accelerations(p, i, gravity, external, a, alpha);
-            Integrator::advance(pos, v, a, dt);
-            Integrator::advance(ang, w, alpha, dt);
-            v_sync = Integrator::synchronous_velocity(v, a, dt);
-            w_sync = Integrator::synchronous_velocity(w, alpha, dt);
-        } else if (kind == motion::prescribed_horizontal) {
-            const vec3<Real> a{0, 0, p.force[i].z / p.mass[i]}; // x and y stay at their velocity
-            Integrator::advance(pos, v, a, dt);
-            v_sync = Integrator::synchronous_velocity(v, a, dt);
-            if (!drifted) ang += w * dt;
-        } else if (!drifted) {
-            pos += vec_cast<Coord>(v * dt);
-            ang += w * dt;
-        }
+        const auto kind = static_cast<motion>(p.kind[i]);
+        vec4<Coord> x = p.x[i]; // aggregates not const: see the note in contact/evaluate.cuh
+        vec3<Coord> pos = x.xyz();
+        vec3<Real> v = p.v[i], w = p.omega[i], ang = drifted ? vec3<Real>{0, 0, 0} : p.angpos[i];
+        vec3<Real> a, alpha;
+        accelerations<External>(p, i, kind, gravity, external, a, alpha);
+        Integrator::advance(pos, v, a, dt);
+        Integrator::advance(ang, w, alpha, dt);
         if (!drifted) {
-            p.x[i] = {box.wrap(pos.x, 0), box.wrap(pos.y, 1), box.wrap(pos.z, 2), x.w};
+            pos = wrapped(box, pos);
+            p.x[i] = {pos.x, pos.y, pos.z, x.w};
             p.angpos[i] = ang;
         }
         p.v[i] = v;
         p.omega[i] = w;
-        p.v_sync[i] = v_sync;
-        p.omega_sync[i] = w_sync;
+        if (Integrator::distinct_synchronous_velocity) {
+            p.v_sync[i] = Integrator::synchronous_velocity(v, a, dt);
+            p.omega_sync[i] = Integrator::synchronous_velocity(w, alpha, dt);
+        }
     }
 };
 
 /// The part of an integrator's step before the forces (velocity Verlet's first half kick,
-/// with the forces of the last step, and its drift): free and horizontally prescribed
-/// particles by Integrator::drift, prescribed ones at their own velocities. The dashpots of
-/// the next force evaluation see the velocities between the kicks.
-template <class P, class Integrator>
+/// with the forces of the last step, and its drift): every kind by Integrator::drift with its
+/// own accelerations, as in integrate_particles. The dashpots of the next force evaluation see
+/// the velocities between the kicks.
+template <class P, class Integrator, bool External = false>
 struct drift_particles {
     using Real = real_t<P>;
     using Coord = coord_t<P>;
@@ -89,54 +115,31 @@ struct drift_particles {
     world<Coord> box;
     vec3<Real> gravity;
     Real dt;
-    const vec3<Real>* external; ///< external force on each particle (N), or null
+    const vec3<Real>* external; ///< external force on each particle (N), read with External
 
-    SPHERE_HD void operator()(std::size_t i) const
+    SPHERE_HDI void operator()(std::size_t i) const
     {
+        static_assert(!Integrator::distinct_synchronous_velocity, "a drifting integrator keeps one velocity");
         const auto kind = static_cast<motion>(p.kind[i]);
-        if (kind == motion::fixed) return;
-        const vec4<Coord> x = p.x[i];
+        vec4<Coord> x = p.x[i];
         vec3<Coord> pos = x.xyz();
         vec3<Real> v = p.v[i], w = p.omega[i], ang = p.angpos[i];
-        if (kind == motion::free) {
-            vec3<Real> a, alpha;
-            free_accelerations(p, i, gravity, external, a, alpha);
-            Integrator::drift(pos, v, a, dt);
-            Integrator::drift(ang, w, alpha, dt);
-        } else if (kind == motion::prescribed_horizontal) {
-            Integrator::drift(pos, v, vec3<Real>{0, 0, p.force[i].z / p.mass[i]}, dt);
-            ang += w * dt;
-        } else {
-            pos += vec_cast<Coord>(v * dt);
-            ang += w * dt;
-        }
-        p.x[i] = {box.wrap(pos.x, 0), box.wrap(pos.y, 1), box.wrap(pos.z, 2), x.w};
+        vec3<Real> a, alpha;
+        accelerations<External>(p, i, kind, gravity, external, a, alpha);
+        Integrator::drift(pos, v, a, dt);
+        Integrator::drift(ang, w, alpha, dt);
+        pos = wrapped(box, pos);
+        p.x[i] = {pos.x, pos.y, pos.z, x.w};
         p.v[i] = v;
         p.omega[i] = w;
-        p.v_sync[i] = v;
-        p.omega_sync[i] = w;
         p.angpos[i] = ang;
     }
 };
 
-/// Result of the post-step check: the largest squared displacement since the contact lists
-/// were built (m^2), and the lowest user index of a particle that is non-finite or outside the
-/// walls on a wall axis (~0 when none is).
-template <class Real>
-struct step_check {
-    Real max_displacement2;
-    std::size_t first_bad;
-};
-
-struct combine_checks {
-    template <class Real>
-    SPHERE_HD step_check<Real> operator()(const step_check<Real>& a, const step_check<Real>& b) const
-    {
-        return {a.max_displacement2 < b.max_displacement2 ? b.max_displacement2 : a.max_displacement2,
-                b.first_bad < a.first_bad ? b.first_bad : a.first_bad};
-    }
-};
-
+/// The post-step check of particle i: the squared displacement since the contact lists were
+/// built (m^2), or +infinity when the particle is non-finite or outside the walls on a wall
+/// axis (`bad`). The largest over all particles decides on a rebuild, and +infinity sends
+/// the simulation looking for the particle to report.
 template <class P>
 struct check_particle {
     using Coord = coord_t<P>;
@@ -145,25 +148,45 @@ struct check_particle {
     world<Coord> box;
     wall_set<Coord> walls;
 
-    SPHERE_HD step_check<Coord> operator()(std::size_t i) const
+    SPHERE_HDI bool bad(std::size_t i) const
     {
-        const vec3<Coord> pos = p.x[i].xyz();
-        bool bad = !isfinite(pos) || !isfinite(p.v_sync[i]) || !isfinite(p.omega_sync[i]);
-        for (int a = 0; a < 3; ++a)
-            if (!box.periodic(a) && !(pos[a] >= Coord(walls.face[2 * a].position) && pos[a] <= Coord(walls.face[2 * a + 1].position)))
-                bad = true;
-        const Coord moved = norm2(box.nearest_image(pos - x_at_build[i].xyz()));
-        return {bad ? Coord(0) : moved, bad ? std::size_t(p.user[i]) : ~std::size_t(0)};
+        vec3<Coord> pos = p.x[i].xyz();
+        bool out = !(isfinite(pos) & isfinite(p.v_sync[i]) & isfinite(p.omega_sync[i]));
+        for (int a = 0; a < 3; ++a) {
+            const bool inside = (pos[a] >= Coord(walls.face[2 * a].position)) & (pos[a] <= Coord(walls.face[2 * a + 1].position));
+            out = out | (!box.periodic(a) & !inside);
+        }
+        return out;
+    }
+
+    SPHERE_HDI Coord operator()(std::size_t i) const
+    {
+        // Written so that the displacement is computed whatever the outcome (the compiler
+        // cannot load fields conditionally in SIMD lanes): a NaN becomes +infinity, and a bad
+        // particle's +infinity wins the maximum.
+        const Coord inf = infinity<Coord>;
+        Coord moved = norm2(box.nearest_image_inside(p.x[i].xyz() - x_at_build[i].xyz())); // both wrapped
+        moved = moved == moved ? moved : inf;
+        const Coord flag = bad(i) ? inf : Coord(0);
+        return moved > flag ? moved : flag;
     }
 };
 
-/// Runs a particle kernel `body` on particle i, then checks the particle (kernel body of a
-/// transform_reduce: one parallel pass instead of two).
+/// The user index of particle i when the check finds it bad, else ~0 (for the lowest one:
+/// the particle a run-time error names).
+template <class P>
+struct bad_particle {
+    check_particle<P> check;
+    SPHERE_HD std::size_t operator()(std::size_t i) const { return check.bad(i) ? std::size_t(check.p.user[i]) : ~std::size_t(0); }
+};
+
+/// Runs a particle kernel `body` on particle i, then returns the particle check (kernel body
+/// of a transform_reduce: one parallel pass instead of two).
 template <class Body, class P>
 struct then_check {
     Body body;
     check_particle<P> check;
-    SPHERE_HD step_check<coord_t<P>> operator()(std::size_t i) const
+    SPHERE_HDI coord_t<P> operator()(std::size_t i) const
     {
         body(i);
         return check(i);

@@ -27,7 +27,7 @@ struct semi_implicit_euler {
     /// the velocity at the positions' time differs from v (and is stored apart, v_sync)
     static constexpr bool distinct_synchronous_velocity = true;
     template <class Coord, class Real>
-    SPHERE_HD static void advance(vec3<Coord>& x, vec3<Real>& v, const vec3<Real>& a, Real dt)
+    SPHERE_HDI static void advance(vec3<Coord>& x, vec3<Real>& v, const vec3<Real>& a, Real dt)
     {
         v += a * dt;
         x += vec_cast<Coord>(v * dt);
@@ -36,7 +36,7 @@ struct semi_implicit_euler {
     /// v is the mid-step velocity v(t + dt/2); the velocity at the new position's time is
     /// v + a dt / 2 up to O(dt^2) (a from the step just taken).
     template <class Real>
-    SPHERE_HD static vec3<Real> synchronous_velocity(const vec3<Real>& v, const vec3<Real>& a, Real dt)
+    SPHERE_HDI static vec3<Real> synchronous_velocity(const vec3<Real>& v, const vec3<Real>& a, Real dt)
     {
         return v + a * (dt / 2);
     }
@@ -48,14 +48,14 @@ struct taylor2 {
     static constexpr bool drifts_before_forces = false;
     static constexpr bool distinct_synchronous_velocity = false;
     template <class Coord, class Real>
-    SPHERE_HD static void advance(vec3<Coord>& x, vec3<Real>& v, const vec3<Real>& a, Real dt)
+    SPHERE_HDI static void advance(vec3<Coord>& x, vec3<Real>& v, const vec3<Real>& a, Real dt)
     {
         x += vec_cast<Coord>(v * dt + a * (dt * dt / 2));
         v += a * dt;
     }
 
     template <class Real>
-    SPHERE_HD static vec3<Real> synchronous_velocity(const vec3<Real>& v, const vec3<Real>&, Real)
+    SPHERE_HDI static vec3<Real> synchronous_velocity(const vec3<Real>& v, const vec3<Real>&, Real)
     {
         return v;
     }
@@ -67,14 +67,14 @@ struct explicit_euler {
     static constexpr bool drifts_before_forces = false;
     static constexpr bool distinct_synchronous_velocity = false;
     template <class Coord, class Real>
-    SPHERE_HD static void advance(vec3<Coord>& x, vec3<Real>& v, const vec3<Real>& a, Real dt)
+    SPHERE_HDI static void advance(vec3<Coord>& x, vec3<Real>& v, const vec3<Real>& a, Real dt)
     {
         x += vec_cast<Coord>(v * dt);
         v += a * dt;
     }
 
     template <class Real>
-    SPHERE_HD static vec3<Real> synchronous_velocity(const vec3<Real>& v, const vec3<Real>&, Real)
+    SPHERE_HDI static vec3<Real> synchronous_velocity(const vec3<Real>& v, const vec3<Real>&, Real)
     {
         return v;
     }
@@ -90,20 +90,20 @@ struct velocity_verlet {
     static constexpr bool distinct_synchronous_velocity = false;
 
     template <class Coord, class Real>
-    SPHERE_HD static void drift(vec3<Coord>& x, vec3<Real>& v, const vec3<Real>& a, Real dt)
+    SPHERE_HDI static void drift(vec3<Coord>& x, vec3<Real>& v, const vec3<Real>& a, Real dt)
     {
         v += a * (dt / 2);
         x += vec_cast<Coord>(v * dt);
     }
 
     template <class Coord, class Real>
-    SPHERE_HD static void advance(vec3<Coord>&, vec3<Real>& v, const vec3<Real>& a, Real dt)
+    SPHERE_HDI static void advance(vec3<Coord>&, vec3<Real>& v, const vec3<Real>& a, Real dt)
     {
         v += a * (dt / 2);
     }
 
     template <class Real>
-    SPHERE_HD static vec3<Real> synchronous_velocity(const vec3<Real>& v, const vec3<Real>&, Real)
+    SPHERE_HDI static vec3<Real> synchronous_velocity(const vec3<Real>& v, const vec3<Real>&, Real)
     {
         return v;
     }

@@ -1,0 +1,231 @@
+#pragma once
+/// \file
+/// One contact evaluated: a particle pair (`pair_contact`, for the pair's owner in the contact
+/// lists) and a particle's walls (`wall_contacts`). The interaction (contact/interact.cuh)
+/// decides which pairs to evaluate and where the results go.
+///
+/// Dashpots see the velocities at the time of the positions (v_sync, omega_sync); tangential
+/// springs follow the displacement of the last step (v, omega times dt: the velocities that
+/// moved the positions). With `OneVelocity` (velocity Verlet) the two are the same, and v,
+/// omega are not read a second time. Equations: docs/physics.md.
+///
+/// A note for code that the host runs in SIMD lanes (this file, the contact laws, the tiles of
+/// contact/interact.cuh, integrate/integrate_particles.cuh), so that g++ keeps vectorising it
+/// (docs/architecture.md, "Vectorised host loops"): aggregate locals (a vec3, a result struct)
+/// initialised by a call or a copy are not declared const, because g++ 12 then keeps them in
+/// memory; conditionals on whole structs go through select(); no field is loaded or stored
+/// only under a condition.
+#include <cmath>
+#include <cstddef>
+#include <type_traits>
+
+#include "../boundary/walls.cuh"
+#include "../boundary/world.cuh"
+#include "../core/constants.cuh"
+#include "../particles/state.cuh"
+#include "contact_lists.cuh"
+#include "params.cuh"
+#include "result.cuh"
+
+namespace sphere {
+namespace detail {
+
+/// The particles' forces on the six wall faces, along each face's axis (N), summed in double.
+struct wall_loads {
+    double force[6];
+    SPHERE_HDI wall_loads operator+(const wall_loads& b) const
+    {
+        wall_loads out;
+        for (int f = 0; f < 6; ++f) out.force[f] = force[f] + b.force[f];
+        return out;
+    }
+};
+
+/// The normal overlap-distance delta_n = |d| - reach (m, negative in contact) from a
+/// separation d, its squared length dist2 and the sum of radii, and the unit normal d / |d|.
+/// When positions are held in a wider type than the contact law's (precision mixed), the
+/// difference dist2 - reach^2 is formed in that type and divided by |d| + reach in the narrow
+/// one: the overlap keeps its relative precision although |d| and reach agree to 1e-5.
+template <class Real, class Coord>
+SPHERE_HDI Real overlap_and_normal(const vec3<Coord>& d, Coord dist2, Coord reach, vec3<Real>& n)
+{
+    if constexpr (std::is_same_v<Real, Coord>) {
+        const Real dist = std::sqrt(dist2);
+        n = d * (Real(1) / dist);
+        return dist - reach;
+    } else {
+        const Real dist = std::sqrt(Real(dist2));
+        n = vec_cast<Real>(d) * (Real(1) / dist);
+        return Real(dist2 - reach * reach) / (dist + Real(reach));
+    }
+}
+
+/// One evaluated pair contact, for its owner i and its partner j.
+template <class Real>
+struct pair_result {
+    vec3<Real> force{0, 0, 0};    ///< contact force on i (N); j feels -force
+    vec3<Real> torque_i{0, 0, 0}; ///< torque on i (N m)
+    vec3<Real> torque_j{0, 0, 0}; ///< torque on j (N m)
+    Real fn = 0;                  ///< |f_n| (N)
+    Real visc_rate = 0;           ///< viscous dissipation of the contact, normal + tangential (W)
+    Real fric_rate = 0;           ///< frictional dissipation of the contact (W)
+    vec4<Real> record{0, 0, 0, 0}; ///< f_t on i (N) in xyz, f_n . n (N) in w: the recorded contact force
+};
+
+/// Evaluates pair contacts of the particles p: positions, the world and the walls in
+/// coord_t<P>, everything the contact law sees in real_t<P>.
+template <class P, class Law, bool OneVelocity>
+struct pair_contact {
+    using Real = real_t<P>;
+    using Coord = coord_t<P>;
+    particle_view<P> p;
+    world<Coord> box;
+    contact_params<Real> params;
+    Real dt;
+
+    /// The contact of i (owner) and j (slots) with history h (updated): both particles'
+    /// share, or zero when they do not touch (overlap with distinct centres), which also
+    /// resets the history. `Branchless` evaluates the law whatever the distance and selects the
+    /// result, so that a loop over pairs vectorises (non-touching pairs may then produce
+    /// non-finite intermediates, which are discarded); otherwise non-touching pairs return
+    /// early.
+    template <bool Branchless>
+    SPHERE_HDI pair_result<Real> evaluate(std::size_t i, std::size_t j, vec4<Real>& h) const
+    {
+        const vec4<Coord> xi = p.x[i], xj = p.x[j];
+        vec3<Coord> d = box.nearest_image_inside(xi.xyz() - xj.xyz());
+        const Coord dist2 = norm2(d), reach = xi.w + xj.w;
+        const bool touching = dist2 < reach * reach && dist2 > Coord(0);
+        if constexpr (!Branchless) {
+            if (!touching) {
+                h = vec4<Real>{0, 0, 0, 0}; // a contact that has ended forgets its history
+                return {};
+            }
+        }
+        vec3<Real> n;
+        const Real delta_n = overlap_and_normal(d, dist2, reach, n);
+        const Real arm_i = Real(xi.w) + delta_n / 2, arm_j = Real(xj.w) + delta_n / 2;
+        const Real mi = p.mass[i], mj = p.mass[j];
+        contact_motion<Real> m;
+        m.n = n;
+        m.delta_n = delta_n;
+        m.velocity = p.v_sync[i] - p.v_sync[j] + arm_i * cross(n, p.omega_sync[i]) + arm_j * cross(n, p.omega_sync[j]);
+        m.step = OneVelocity ? m.velocity * dt
+                             : (p.v[i] - p.v[j]) * dt + arm_i * cross(n, p.omega[i] * dt) +
+                                   arm_j * cross(n, p.omega[j] * dt);
+        m.m_eff = mi * mj / (mi + mj);
+        vec4<Real> updated = h;
+        contact_result<Real> c = Law::pair(params, m, updated, dt);
+        vec3<Real> lever = cross(n, c.tangential);
+        pair_result<Real> r;
+        r.force = c.normal + c.tangential;
+        r.torque_i = -arm_i * lever;
+        r.torque_j = -arm_j * lever;
+        r.fn = c.fn;
+        r.visc_rate = c.visc_rate;
+        r.fric_rate = c.fric_rate;
+        r.record = {c.tangential.x, c.tangential.y, c.tangential.z, dot(c.normal, n)};
+        if constexpr (Branchless) {
+            const vec3<Real> zero{0, 0, 0};
+            r.force = select(touching, r.force, zero);
+            r.torque_i = select(touching, r.torque_i, zero);
+            r.torque_j = select(touching, r.torque_j, zero);
+            r.fn = touching ? r.fn : Real(0);
+            r.visc_rate = touching ? r.visc_rate : Real(0);
+            r.fric_rate = touching ? r.fric_rate : Real(0);
+            r.record = select(touching, r.record, vec4<Real>{0, 0, 0, 0});
+            updated = select(touching, updated, vec4<Real>{0, 0, 0, 0});
+        }
+        h = updated;
+        return r;
+    }
+};
+
+/// The wall contacts of a particle that has some: the wall entries at the end of its row in
+/// the contact lists (one index per entry of contact_lists::wall_ranks, the ranks of such
+/// particles). Adds their forces and torques to the particle's, with `Book` their |f_n| and
+/// dissipation rates to its audit sums (completed by finish_audit), with `Record` stores each
+/// entry's force; returns the particle's loads on the walls.
+template <class P, class Law, bool Book, bool Record, bool OneVelocity>
+struct wall_contacts {
+    using Real = real_t<P>;
+    using Coord = coord_t<P>;
+    particle_view<P> p;
+    contact_view<Real> c;
+    const unsigned* ranks; ///< contact_lists::wall_ranks
+    wall_set<Coord> walls;
+    contact_params<Real> params;
+    Real dt;
+    bool update_history; ///< false for a force evaluation that must leave the contacts as they are
+
+    SPHERE_HD wall_loads operator()(std::size_t k) const
+    {
+        wall_loads loads{{0, 0, 0, 0, 0, 0}};
+        const std::size_t r = ranks[k], i = c.slot(r);
+        const unsigned first = c.offset[r];
+        const vec4<Coord> xi = p.x[i];
+        const vec3<Real> vi = p.v_sync[i], wi = p.omega_sync[i];
+        const vec3<Real> si = OneVelocity ? vec3<Real>{0, 0, 0} : p.v[i] * dt;
+        const vec3<Real> ti = OneVelocity ? vec3<Real>{0, 0, 0} : p.omega[i] * dt;
+        vec3<Real> force = p.force[i], torque = p.torque[i];
+        Real fn_sum = 0, visc = 0, fric = 0;
+        for (unsigned e = c.offset[r + 1]; e > first && c.partner[e - 1] >= wall_partner_base; --e) {
+            const unsigned k = e - 1;
+            const int f = static_cast<int>(c.partner[k] - wall_partner_base);
+            const wall_face<Coord>& wall = walls.face[f];
+            const int a = f / 2;
+            vec3<Real> n = wall_set<Real>::inward_normal(f);
+            const Coord dist_c = (xi.xyz()[a] - Coord(wall.position)) * Coord(n[a]);
+            const Real dist = Real(dist_c), delta_n = Real(dist_c - xi.w);
+            vec4<Real> h = c.history[k];
+            if (delta_n < Real(0)) {
+                contact_motion<Real> m{n, delta_n, vi + dist * cross(n, wi), si + dist * cross(n, ti), p.mass[i]};
+                m.velocity[a] -= Real(wall.velocity);
+                if (OneVelocity) m.step = m.velocity * dt;
+                else m.step[a] -= Real(wall.velocity) * dt;
+                contact_result<Real> r = Law::wall(params, m, h, dt);
+                loads.force[f] = -double(r.normal[a] + r.tangential[a]);
+                force += r.normal + r.tangential;
+                torque -= dist * cross(n, r.tangential);
+                if (Book) {
+                    fn_sum += r.fn;
+                    visc += r.visc_rate;
+                    fric += r.fric_rate;
+                }
+                if (Record) c.force[k] = {r.tangential.x, r.tangential.y, r.tangential.z, dot(r.normal, n)};
+            } else {
+                h = vec4<Real>{0, 0, 0, 0}; // a contact that has ended forgets its history
+                if (Record) c.force[k] = vec4<Real>{0, 0, 0, 0};
+            }
+            if (update_history) c.history[k] = h;
+        }
+        p.force[i] = force;
+        p.torque[i] = torque;
+        if (Book) {
+            p.pressure[i] += fn_sum;
+            p.p_visc[i] += visc;
+            p.p_fric[i] += fric;
+        }
+        return loads;
+    }
+};
+
+/// Completes the energy audit of particle i once its contacts are summed: the sum of |f_n|
+/// becomes a pressure over the surface, 4 pi r^2 (Pa), and the step's dissipation rates are
+/// booked as energies (J).
+template <class P>
+struct finish_audit {
+    using Real = real_t<P>;
+    particle_view<P> p;
+    Real dt;
+    SPHERE_HDI void operator()(std::size_t i) const
+    {
+        const Real r = Real(p.x[i].w);
+        p.pressure[i] = p.pressure[i] / (4 * pi<Real> * r * r);
+        p.e_visc[i] += p.p_visc[i] * dt;
+        p.e_fric[i] += p.p_fric[i] * dt;
+    }
+};
+
+} // namespace detail
+} // namespace sphere
