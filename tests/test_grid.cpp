@@ -696,10 +696,27 @@ TEST_CASE("the slab phases let no two tasks of a phase write the same layer", "[
     for (unsigned layers = 1; layers <= 9; ++layers)
         for (bool periodic : {false, true}) {
             if (periodic && layers < 3) continue; // a periodic axis has at least 3 cells
-            std::vector<unsigned> entries(layers + 1);
-            for (unsigned l = 0; l <= layers; ++l) entries[l] = 10 * l + l * l; // uneven weights
+            // uneven weights, and no entries at all in the first and last two layers (a bed in
+            // a tall box): those layers' particles still need a thread
+            std::vector<unsigned> entries(layers + 1, 0);
+            for (unsigned l = 0; l < layers; ++l) {
+                const bool empty = l == 0 || l + 2 >= layers;
+                entries[l + 1] = entries[l] + (empty ? 0 : 10 + l);
+            }
             const sphere::detail::slab_phases phases(entries, periodic);
             INFO(layers << " layers, periodic " << periodic);
+            // The threads' blocks of layers partition all layers, in order.
+            for (int threads = 1; threads <= 5; ++threads) {
+                unsigned next = 0;
+                for (int t = 0; t < threads; ++t) {
+                    unsigned first, end;
+                    phases.block(t, threads, first, end);
+                    if (first >= end) continue;
+                    CHECK(first == next);
+                    next = end;
+                }
+                CHECK(next == layers);
+            }
             std::vector<int> owned(layers, 0);
             for (int ph = 0; ph < 2; ++ph) {
                 for (const auto& task : phases.phase[ph])

@@ -10,6 +10,10 @@
 #include <utility>
 #include <vector>
 
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
 #include "analysis/energy.cuh"
 #include "boundary/wall_control.cuh"
 #include "boundary/walls.cuh"
@@ -59,6 +63,49 @@ struct by_rank {
     Body body;
     contact_view<Real> c;
     SPHERE_HDI auto operator()(std::size_t r) const { return body(c.slot(r)); }
+};
+
+/// What follows the pair sums on the host's slab schedule, for the particles of a block of
+/// ranks, on the thread that summed most of their pairs and in the same parallel region
+/// (contact/interact.cuh, sum_by_slabs): their wall contacts (each wall particle's loads into
+/// `loads`, by its index in contact_lists::wall_ranks, for an ordered sum afterwards), then
+/// `body` (the integration) and, with `Check`, the particle check (the thread's largest result
+/// into moved[thread]).
+template <class P, class Walls, class Body, bool Check>
+struct finish_block {
+    using Real = real_t<P>;
+    using Coord = coord_t<P>;
+    Walls walls;
+    Body body;
+    check_particle<P> check;
+    contact_view<Real> c;
+    const unsigned* wall_ranks; ///< host memory
+    std::size_t wall_count;
+    wall_loads* loads;
+    Coord* moved;
+
+    void operator()(unsigned first, unsigned end, int thread) const
+    {
+        const unsigned* lo = std::lower_bound(wall_ranks, wall_ranks + wall_count, first);
+        const unsigned* hi = std::lower_bound(lo, wall_ranks + wall_count, end);
+        for (const unsigned* k = lo; k < hi; ++k) loads[k - wall_ranks] = walls(std::size_t(k - wall_ranks));
+        Coord most = 0;
+        for (unsigned begin = first; begin < end; begin += unsigned(host_chunk)) {
+            const unsigned stop = end - begin > host_chunk ? begin + unsigned(host_chunk) : end;
+            if constexpr (Check) {
+                by_rank<then_check<Body, P>, Real> f{{body, check}, c};
+                Coord values[host_chunk];
+                SPHERE_VECTORISE_LOOP
+                for (unsigned r = begin; r < stop; ++r) values[r - begin] = f(r);
+                for (unsigned r = begin; r < stop; ++r) most = max_op{}(most, values[r - begin]);
+            } else {
+                by_rank<Body, Real> f{body, c};
+                SPHERE_VECTORISE_LOOP
+                for (unsigned r = begin; r < stop; ++r) f(r);
+            }
+        }
+        if (Check) moved[thread] = most;
+    }
 };
 
 /// Runs two particle kernels on particle i, one after the other.
@@ -482,18 +529,14 @@ private:
                                                                                   external}),
                   steps_ + 1);
         if (needs_rebuild_) rebuild_lists();
-        interaction_.template sum_pairs<Book, Record>(pair_contact(), lists_, summation_, true);
-        const detail::wall_loads loads = sum_walls<Book, Record>(true);
+        detail::wall_loads loads{{0, 0, 0, 0, 0, 0}};
         Coord moved2 = 0;
         if constexpr (Book) {
             const detail::both<detail::finish_audit<Precision>, decltype(integrate)> body{{p, Real(dt_)}, integrate};
-            if constexpr (drifted) for_each_index(Policy{}, n, body);
-            else moved2 = checked(body);
+            finish_step<Book, Record>(body, loads, moved2);
         } else {
-            if constexpr (drifted) for_each_index(Policy{}, n, integrate);
-            else moved2 = checked(integrate);
-        }
-        advance_walls(walls_, settings_.walls, settings_.box, loads.force, time_, dt_, steps_ + 1);
+            finish_step<Book, Record>(integrate, loads, moved2);
+        }        advance_walls(walls_, settings_.walls, settings_.box, loads.force, time_, dt_, steps_ + 1);
         if (drive_)
             drive_work_ += transform_reduce(Policy{}, n,
                                             detail::by_rank<detail::drive_power<Precision>, Real>{{p, gravity_},
@@ -507,13 +550,52 @@ private:
             if (steps_ % o.first == 0) o.second(*this);
     }
 
+    /// The pair sums, the walls and `body` (the integration after the forces), with the
+    /// particle check when the integrator moves the particles after the forces: in one parallel
+    /// region on the host's slab schedule, else pass after pass. Returns the wall loads and
+    /// the largest squared displacement of the check.
+    template <bool Book, bool Record, class Body>
+    void finish_step(const Body& body, detail::wall_loads& loads, Coord& moved2)
+    {
+        constexpr bool check_here = !Integrator::drifts_before_forces;
+        const auto walls = wall_contacts<Book, Record>(true);
+        if constexpr (std::is_same_v<Policy, host>) {
+            const std::size_t count = lists_.wall_particles();
+            wall_loads_.assign(count, detail::wall_loads{{0, 0, 0, 0, 0, 0}});
+            std::vector<Coord> moved(std::size_t(max_threads()), Coord(0));
+            const detail::finish_block<Precision, decltype(walls), Body, check_here> finish{
+                walls, body, check(), lists_.view(), lists_.wall_ranks(), count, wall_loads_.data(), moved.data()};
+            if (interaction_.template sum_pairs<Book, Record>(pair_contact(), lists_, summation_, true, finish)) {
+                for (const detail::wall_loads& l : wall_loads_) loads = loads + l;
+                for (Coord m : moved) moved2 = max_op{}(moved2, m);
+                return;
+            }
+        } else {
+            interaction_.template sum_pairs<Book, Record>(pair_contact(), lists_, summation_, true);
+        }
+        loads = transform_reduce(Policy{}, lists_.wall_particles(), walls, detail::wall_loads{{0, 0, 0, 0, 0, 0}},
+                                 plus_op{});
+        if constexpr (check_here) moved2 = checked(body);
+        else for_each_index(Policy{}, particles_.size(), body);
+    }
+
+    static int max_threads()
+    {
+#ifdef _OPENMP
+        return omp_get_max_threads();
+#else
+        return 1;
+#endif
+    }
+
     /// The forces of the current positions, leaving the contacts' histories and the energy
     /// audit as they are (for an integrator that needs the forces before its first step).
     template <bool Record>
     void initial_forces()
     {
         interaction_.template sum_pairs<false, Record>(pair_contact(), lists_, summation_, false);
-        sum_walls<false, Record>(false);
+        transform_reduce(Policy{}, lists_.wall_particles(), wall_contacts<false, Record>(false),
+                         detail::wall_loads{{0, 0, 0, 0, 0, 0}}, plus_op{});
     }
 
     detail::pair_contact<Precision, Law, Integrator::drifts_before_forces> pair_contact()
@@ -521,15 +603,12 @@ private:
         return {particles_.view(), settings_.box, pair_params_, Real(dt_)};
     }
 
-    /// Adds the wall contacts to the forces of the particles that have some; returns their
-    /// loads on the walls, summed in rank order (whatever the storage order).
+    /// The wall contacts of the particles that have some (one index per wall particle, in rank
+    /// order), adding to their forces and returning their loads on the walls.
     template <bool Book, bool Record>
-    detail::wall_loads sum_walls(bool update_history)
+    detail::wall_contacts<Precision, Law, Book, Record, Integrator::drifts_before_forces> wall_contacts(bool update_history)
     {
-        const detail::wall_contacts<Precision, Law, Book, Record, Integrator::drifts_before_forces> walls{
-            particles_.view(), lists_.view(), lists_.wall_ranks(), walls_, wall_params_, Real(dt_), update_history};
-        return transform_reduce(Policy{}, lists_.wall_particles(), walls, detail::wall_loads{{0, 0, 0, 0, 0, 0}},
-                                plus_op{});
+        return {particles_.view(), lists_.view(), lists_.wall_ranks(), walls_, wall_params_, Real(dt_), update_history};
     }
 
     /// Runs the particle kernel `body` on every particle and checks each one after it, in one
@@ -629,6 +708,7 @@ private:
     wall_set<Coord> walls_at_build_;      ///< the walls when the lists were built
     bool drive_ = false;                  ///< some particle is prescribed: book the drive's work
     buffer<vec3<Real>, Policy> external_; ///< external forces (empty until external_forces() is called)
+    std::vector<detail::wall_loads> wall_loads_; ///< each wall particle's loads of the step (host)
     std::vector<motion> kinds_; ///< host copy of each particle's motion (it never changes)
     std::vector<std::pair<std::size_t, observer>> observers_;
 };
