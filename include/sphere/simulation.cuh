@@ -226,7 +226,8 @@ public:
         }
         dt_ = Coord(Real(dt_)); // the kernels step velocities with dt in Real: one dt throughout
 
-        particles_ = particle_state<Precision, Policy>(particles, Integrator::distinct_synchronous_velocity);
+        particles_ = particle_state<Precision, Policy>(particles, Integrator::distinct_synchronous_velocity,
+                                                       s.energy_audit);
         for (const particle<Coord>& p : particles) {
             kinds_.push_back(p.kind);
             if (p.kind == motion::prescribed || p.kind == motion::prescribed_horizontal) drive_ = true;

@@ -90,10 +90,12 @@ struct particle_energy {
                 if (delta_n < Real(0)) e.elastic += Coord(Law::wall_energy(wall_params, delta_n, c.history[k]));
             }
         }
-        e.dissipated_visc = p.e_visc[i];
-        e.dissipated_fric = p.e_fric[i];
-        e.rate_visc = p.p_visc[i];
-        e.rate_fric = p.p_fric[i];
+        if (p.e_visc) { // the energy audit is on
+            e.dissipated_visc = p.e_visc[i];
+            e.dissipated_fric = p.e_fric[i];
+            e.rate_visc = p.p_visc[i];
+            e.rate_fric = p.p_fric[i];
+        }
         return e;
     }
 };

@@ -270,6 +270,46 @@ struct fill_entries {
     }
 };
 
+/// How many entries of row r have a non-zero history.
+template <class Real>
+struct count_histories {
+    const unsigned* offset;
+    const vec4<Real>* history;
+    unsigned* count;
+    SPHERE_HD void operator()(std::size_t r) const
+    {
+        unsigned c = 0;
+        for (unsigned e = offset[r]; e < offset[r + 1]; ++e) {
+            const vec4<Real> h = history[e];
+            c += h.x != Real(0) || h.y != Real(0) || h.z != Real(0) || h.w != Real(0);
+        }
+        count[r] = c;
+    }
+};
+
+/// Copies the entries of row r with a non-zero history to its place in smaller lists.
+template <class Real>
+struct copy_histories {
+    const unsigned* offset;
+    const unsigned* partner;
+    const vec4<Real>* history;
+    const unsigned* to_offset;
+    unsigned* to_partner;
+    vec4<Real>* to_history;
+    SPHERE_HD void operator()(std::size_t r) const
+    {
+        unsigned k = to_offset[r];
+        for (unsigned e = offset[r]; e < offset[r + 1]; ++e) {
+            const vec4<Real> h = history[e];
+            if (h.x != Real(0) || h.y != Real(0) || h.z != Real(0) || h.w != Real(0)) {
+                to_partner[k] = partner[e];
+                to_history[k] = h;
+                ++k;
+            }
+        }
+    }
+};
+
 /// Whether rank r has wall entries (1 or 0), for the list of such ranks.
 struct has_walls {
     const unsigned* offset;
@@ -335,6 +375,7 @@ public:
     void rebuild(const grid_view<Coord>& grid, const wall_set<Coord>& walls, Coord skin, bool keep_order)
     {
         const std::size_t n = size();
+        keep_histories_only(); // the old lists shrink to what the new ones can inherit
         const detail::neighbour_scan<Coord> scan{grid, walls, skin};
         buffer<unsigned, Policy> offset(n + 1, 0u);
         for_each_index(Policy{}, n, detail::count_entries<Coord>{scan, offset.data()});
@@ -353,6 +394,7 @@ public:
         history_.swap(history);
         entries_ = total;
         if (record_forces_) force_ = buffer<vec4<Real>, Policy>(total, vec4<Real>{0, 0, 0, 0});
+        else force_ = buffer<vec4<Real>, Policy>();
         if (keep_order) {
             slot_of_rank_.resize(n);
             rank_of_slot_.resize(n);
@@ -497,6 +539,29 @@ public:
     }
 
 private:
+    /// Replaces the lists by the entries whose history is not zero (contacts that touched at
+    /// the last step, whose history a rebuild carries over), in the same rows, and frees the
+    /// rest before the new lists are built: the rebuild's peak memory holds the new lists and
+    /// these, not two full sets.
+    void keep_histories_only()
+    {
+        const std::size_t n = size();
+        if (entries_ == 0) return;
+        buffer<unsigned, Policy> offset(n + 1, 0u);
+        for_each_index(Policy{}, n, detail::count_histories<Real>{offset_.data(), history_.data(), offset.data()});
+        const std::size_t kept = exclusive_scan_in_place(Policy{}, offset.data(), n + 1);
+        buffer<unsigned, Policy> partner(kept);
+        buffer<vec4<Real>, Policy> history(kept);
+        for_each_index(Policy{}, n,
+                       detail::copy_histories<Real>{offset_.data(), partner_.data(), history_.data(), offset.data(),
+                                                    partner.data(), history.data()});
+        offset_.swap(offset);
+        partner_.swap(partner);
+        history_.swap(history);
+        force_ = buffer<vec4<Real>, Policy>();
+        entries_ = kept;
+    }
+
     /// A host copy of the first n elements of policy memory.
     template <class T>
     static std::vector<T> buffer_copy(const T* data, std::size_t n)

@@ -2,6 +2,7 @@
 /// \file
 /// `buffer<T, Policy>`: an owning array in the memory space of a policy.
 #include <cstddef>
+#include <utility>
 #include <vector>
 
 #include "../core/config.cuh"
@@ -30,6 +31,7 @@ public:
     const T* data() const { return data_.data(); }
     void resize(std::size_t n, const T& value = T{}) { data_.resize(n, value); }
     void assign(const std::vector<T>& values) { data_ = values; }
+    void assign(std::vector<T>&& values) { data_ = std::move(values); }
     std::vector<T> to_host() const { return data_; }
     void swap(buffer& other) noexcept { data_.swap(other.data_); }
 

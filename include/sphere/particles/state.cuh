@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "../core/constants.cuh"
@@ -35,6 +36,7 @@ struct particle_view {
     vec3<Real>* force;      ///< sum of contact forces of the last step (N), without gravity
     vec3<Real>* torque;     ///< sum of contact torques of the last step (N m)
     Real* mass;             ///< (kg)
+    // The energy audit (null without it: settings.energy_audit)
     Real* pressure;         ///< sum of normal contact force magnitudes over the surface, 4 pi r^2 (Pa)
     Real* e_visc;           ///< energy dissipated by normal and tangential viscous damping (J)
     Real* e_fric;           ///< energy dissipated by Coulomb sliding (J)
@@ -97,42 +99,46 @@ public:
 
     /// Fills the arrays from validated particle descriptions. Without `distinct_sync` the
     /// velocities at the positions' time are the velocities themselves (every integrator but
-    /// semi-implicit Euler): v_sync and omega_sync then share v's and omega's arrays.
-    explicit particle_state(const std::vector<particle<Coord>>& particles, bool distinct_sync = true)
-        : distinct_sync_(distinct_sync)
+    /// semi-implicit Euler): v_sync and omega_sync then share v's and omega's arrays. Without
+    /// `audit` there are no energy-audit arrays (pressure, dissipation): snapshots show zeros.
+    explicit particle_state(const std::vector<particle<Coord>>& particles, bool distinct_sync = true,
+                            bool audit = true)
+        : distinct_sync_(distinct_sync), audit_(audit)
     {
-        particle_snapshot<Coord> s;
+        // One field at a time, straight from the descriptions (storage order = user order
+        // until the first rebuild): set-up needs one field's copy beside the arrays.
         const std::size_t n = particles.size();
-        s.x.resize(n);
-        s.v.resize(n);
-        s.omega.resize(n);
-        s.angpos.assign(n, vec3<Coord>{0, 0, 0});
-        s.force.assign(n, vec3<Coord>{0, 0, 0});
-        s.torque.assign(n, vec3<Coord>{0, 0, 0});
-        s.mass.resize(n);
-        s.pressure.assign(n, 0);
-        s.e_visc.assign(n, 0);
-        s.e_fric.assign(n, 0);
-        s.p_visc.assign(n, 0);
-        s.p_fric.assign(n, 0);
-        s.kind.resize(n);
-        for (std::size_t i = 0; i < n; ++i) {
-            const particle<Coord>& p = particles[i];
-            s.x[i] = {p.position.x, p.position.y, p.position.z, p.radius};
-            const bool still = p.kind == motion::fixed;
-            // velocities and masses are held in Real: round them here, so that a snapshot
-            // shows what the arrays hold
-            s.v[i] = still ? vec3<Coord>{0, 0, 0} : vec_cast<Coord>(vec_cast<Real>(p.velocity));
-            s.omega[i] = still ? vec3<Coord>{0, 0, 0} : vec_cast<Coord>(vec_cast<Real>(p.angular_velocity));
-            s.mass[i] = Coord(Real(sphere_mass(p.radius, p.density)));
-            s.kind[i] = static_cast<std::uint8_t>(p.kind);
+        auto field = [&](auto& to, auto value_of) {
+            using T = typename std::remove_reference_t<decltype(to)>::value_type;
+            std::vector<T> values(n);
+            for (std::size_t i = 0; i < n; ++i) values[i] = value_of(particles[i]);
+            to.assign(std::move(values));
+        };
+        const vec3<Real> zero{0, 0, 0};
+        // velocities and masses are held in Real; a fixed particle has none
+        auto velocity = [](const particle<Coord>& p) {
+            return p.kind == motion::fixed ? vec3<Real>{0, 0, 0} : vec_cast<Real>(p.velocity);
+        };
+        auto spin = [](const particle<Coord>& p) {
+            return p.kind == motion::fixed ? vec3<Real>{0, 0, 0} : vec_cast<Real>(p.angular_velocity);
+        };
+        field(x_, [](const particle<Coord>& p) { return vec4<Coord>{p.position.x, p.position.y, p.position.z, p.radius}; });
+        field(v_, velocity);
+        field(omega_, spin);
+        if (distinct_sync_) {
+            field(v_sync_, velocity);
+            field(omega_sync_, spin);
         }
-        s.v_sync = s.v;
-        s.omega_sync = s.omega;
+        angpos_.resize(n, zero);
+        force_.resize(n, zero);
+        torque_.resize(n, zero);
+        field(mass_, [](const particle<Coord>& p) { return Real(sphere_mass(p.radius, p.density)); });
+        if (audit_)
+            for (buffer<Real, Policy>* b : {&pressure_, &e_visc_, &e_fric_, &p_visc_, &p_fric_}) b->resize(n, Real(0));
+        field(kind_, [](const particle<Coord>& p) { return static_cast<std::uint8_t>(p.kind); });
         std::vector<unsigned> identity(n);
         for (std::size_t i = 0; i < n; ++i) identity[i] = static_cast<unsigned>(i);
-        user_.assign(identity);
-        restore(s);
+        user_.assign(std::move(identity));
     }
 
     std::size_t size() const { return x_.size(); }
@@ -141,10 +147,11 @@ public:
     {
         vec3<Real>* v_sync = distinct_sync_ ? v_sync_.data() : v_.data();
         vec3<Real>* omega_sync = distinct_sync_ ? omega_sync_.data() : omega_.data();
-        return {x_.size(),       x_.data(),      v_.data(),      omega_.data(),  v_sync,
-                omega_sync,                                                      angpos_.data(),
-                force_.data(),   torque_.data(), mass_.data(),   pressure_.data(), e_visc_.data(),
-                e_fric_.data(),  p_visc_.data(), p_fric_.data(), kind_.data(),   user_.data()};
+        auto audit = [&](buffer<Real, Policy>& b) { return audit_ ? b.data() : nullptr; };
+        return {x_.size(),       x_.data(),        v_.data(),         omega_.data(),     v_sync,
+                omega_sync,      angpos_.data(),   force_.data(),     torque_.data(),    mass_.data(),
+                audit(pressure_), audit(e_visc_), audit(e_fric_),   audit(p_visc_),    audit(p_fric_),
+                kind_.data(),    user_.data()};
     }
 
     /// The user's index of the particle in each storage slot (host copy).
@@ -177,7 +184,8 @@ public:
         const std::vector<unsigned> user = user_.to_host();
         auto out = [&](const auto& field) {
             const auto slots = field.to_host();
-            std::vector<decltype(widen(slots[0]))> users(slots.size());
+            using T = decltype(widen(typename std::remove_reference_t<decltype(field)>::value_type{}));
+            std::vector<T> users(user.size(), T{}); // zeros for a field that is not kept
             for (std::size_t k = 0; k < slots.size(); ++k) users[user[k]] = widen(slots[k]);
             return users;
         };
@@ -209,11 +217,13 @@ public:
         in(force_, s.force);
         in(torque_, s.torque);
         in(mass_, s.mass);
-        in(pressure_, s.pressure);
-        in(e_visc_, s.e_visc);
-        in(e_fric_, s.e_fric);
-        in(p_visc_, s.p_visc);
-        in(p_fric_, s.p_fric);
+        if (audit_) {
+            in(pressure_, s.pressure);
+            in(e_visc_, s.e_visc);
+            in(e_fric_, s.e_fric);
+            in(p_visc_, s.p_visc);
+            in(p_fric_, s.p_fric);
+        }
         in(kind_, s.kind);
     }
 
@@ -252,6 +262,7 @@ private:
     buffer<std::uint8_t, Policy> kind_;
     buffer<unsigned, Policy> user_;
     bool distinct_sync_ = true; ///< v_sync_, omega_sync_ hold their own values (else empty: v_, omega_)
+    bool audit_ = true;         ///< the energy-audit arrays exist (else empty)
 };
 
 } // namespace sphere
