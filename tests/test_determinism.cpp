@@ -252,6 +252,33 @@ TEMPLATE_TEST_CASE("1 and 2 OpenMP threads give bit-identical states", "[determi
     }
 }
 
+TEMPLATE_TEST_CASE("switching between 1 and 2 threads during a run (the thread governor) keeps the bits",
+                   "[determinism][openmp]", double, sphere::mixed)
+{
+    using P = TestType;
+    using Real = sphere_test::user_real<P>;
+    thread_count_guard guard;
+    // sphere::thread_governor changes host_team_limit() between steps; a run whose limit
+    // alternates 1, 2, 2, 1, ... must end where a run on one thread does.
+    const std::size_t steps = 60;
+    const auto setup = assembly<Real>(14, Real(0.002), 7);
+    const auto with_one = run_on_threads<P>(setup, steps, 1);
+
+    omp_set_num_threads(2);
+    REQUIRE(threads_in_parallel_region() == 2);
+    sphere::simulation<P> sim(setup.first, setup.second);
+    for (std::size_t k = 0; k < steps; ++k) {
+        sphere::host_team_limit() = (k / 2) % 2 == 0 ? 1 : 0;
+        REQUIRE(sphere::host_team() == ((k / 2) % 2 == 0 ? 1 : 2));
+        sim.step();
+    }
+    sphere::host_team_limit() = 0;
+    require_eventful(with_one);
+    const std::vector<std::string> diff = differences(with_one, record_of(sim));
+    INFO("fields that differ: " << Catch::Detail::stringify(diff));
+    CHECK(diff.empty());
+}
+
 TEMPLATE_TEST_CASE("the storage order does not change the physics: reordering on and off agree bit for bit",
                    "[determinism][reorder]", float, double, sphere::mixed)
 {

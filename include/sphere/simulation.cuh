@@ -24,6 +24,7 @@
 #include "core/error.cuh"
 #include "exec/algorithms.cuh"
 #include "exec/for_each.cuh"
+#include "exec/thread_governor.cuh"
 #include "grid/neighbor_grid.cuh"
 #include "integrate/integrate_particles.cuh"
 #include "integrate/integrators.cuh"
@@ -246,6 +247,7 @@ public:
     /// One DEM step of length dt().
     void step()
     {
+        governor_.step();
         if (external_.size()) step_with<true>();
         else step_with<false>();
     }
@@ -712,6 +714,7 @@ private:
     std::vector<detail::wall_loads> wall_loads_; ///< each wall particle's loads of the step (host)
     std::vector<motion> kinds_; ///< host copy of each particle's motion (it never changes)
     std::vector<std::pair<std::size_t, observer>> observers_;
+    thread_governor governor_; ///< all threads or one, whichever is faster on this machine now
 };
 
 } // namespace sphere

@@ -17,6 +17,7 @@
 #include "../exec/algorithms.cuh"
 #include "../exec/buffer.cuh"
 #include "../exec/for_each.cuh"
+#include "../exec/host_team.cuh"
 #include "../exec/policy.cuh"
 #include "contact_lists.cuh"
 #include "evaluate.cuh"
@@ -260,7 +261,7 @@ void sum_by_slabs(const Pairs& pairs, const Zero& zero, const Finish& finish, st
                   const std::vector<unsigned>& layer_start, const slab_phases& phases)
 {
     const long long count = static_cast<long long>(n);
-#pragma omp parallel if (n >= host_parallel_threshold)
+#pragma omp parallel if (n >= host_parallel_threshold) num_threads(host_team())
     {
 #ifdef _OPENMP
         const int threads = omp_get_num_threads(), t = omp_get_thread_num();

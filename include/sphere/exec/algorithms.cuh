@@ -16,6 +16,7 @@
 
 #include "../core/config.cuh"
 #include "for_each.cuh"
+#include "host_team.cuh"
 #include "policy.cuh"
 
 #if SPHERE_CUDA_COMPILER
@@ -40,11 +41,13 @@ struct min_op {
     template <class T> SPHERE_HD T operator()(const T& a, const T& b) const { return b < a ? b : a; }
 };
 
-/// Sorts `keys[0, n)` ascending and applies the same permutation to `values`; stable.
+/// Sorts `keys[0, n)` ascending and applies the same permutation to `values`; stable. On the
+/// calling thread when host_team() is 1 (Thrust's OpenMP sort would start all threads).
 template <class Key, class Value>
 void sort_by_key(host, Key* keys, Value* values, std::size_t n)
 {
-    if (n >= host_parallel_threshold) thrust::stable_sort_by_key(thrust::omp::par, keys, keys + n, values);
+    if (n >= host_parallel_threshold && host_team() > 1)
+        thrust::stable_sort_by_key(thrust::omp::par, keys, keys + n, values);
     else thrust::stable_sort_by_key(thrust::cpp::par, keys, keys + n, values);
 }
 
@@ -71,7 +74,7 @@ T transform_reduce(host, std::size_t n, const Transform& f, T init, Op op)
     const std::size_t chunks = (n + host_chunk - 1) / host_chunk;
     std::vector<T> partial(chunks, init);
     const long long count = static_cast<long long>(chunks);
-#pragma omp parallel for schedule(static) if (chunks > 1)
+#pragma omp parallel for schedule(static) if (chunks > 1) num_threads(host_team())
     for (long long c = 0; c < count; ++c) {
         Transform local = f; // see detail::run_chunk
         const std::size_t begin = static_cast<std::size_t>(c) * host_chunk;

@@ -10,6 +10,7 @@
 
 #include "../core/config.cuh"
 #include "../core/error.cuh"
+#include "host_team.cuh"
 #include "policy.cuh"
 
 namespace sphere {
@@ -42,7 +43,7 @@ template <class Body>
 void for_each_index(host, std::size_t n, const Body& body)
 {
     const long long chunks = static_cast<long long>((n + host_chunk - 1) / host_chunk);
-#pragma omp parallel for schedule(static) if (n >= host_parallel_threshold)
+#pragma omp parallel for schedule(static) if (n >= host_parallel_threshold) num_threads(host_team())
     for (long long c = 0; c < chunks; ++c) {
         const std::size_t begin = static_cast<std::size_t>(c) * host_chunk;
         detail::run_chunk(body, begin, begin + host_chunk < n ? begin + host_chunk : n);
