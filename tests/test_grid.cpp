@@ -750,3 +750,48 @@ TEST_CASE("the slab phases let no two tasks of a phase write the same layer", "[
             for (unsigned l = 0; l < layers; ++l) CHECK(owned[l] == 1);
         }
 }
+
+TEMPLATE_TEST_CASE("every cell's start is the number of particles in lower cells, also in a tall, mostly empty box",
+                   "[grid]", float, double)
+{
+    using Real = TestType;
+    // A column 4 x 4 x 2000 cells of 1 mm with particles in its lowest 20 layers (a sample
+    // settled in a tall box): cells above the last particle all start at n, and so do none
+    // of the cells below it except the empty ones after the last occupied cell of a layer.
+    sphere::world<Real> box;
+    box.lo = {0, 0, 0};
+    box.hi = {Real(0.004), Real(0.004), Real(2.0)};
+    const auto g = sphere::grid_geometry<Real>::make(box, Real(0.001), Real(0));
+    REQUIRE(g.cell_count() >= 4u * 4u * 1999u); // 1999 layers in float, 2000 in double
+    std::size_t n = 0;
+    SECTION("no particles") { n = 0; }
+    SECTION("a settled sample") { n = 300; }
+    std::mt19937 gen(12);
+    std::uniform_real_distribution<double> u(0, 1);
+    std::vector<sphere::vec4<Real>> x(n);
+    std::vector<unsigned> user(n);
+    for (std::size_t i = 0; i < n; ++i) {
+        x[i] = {Real(0.004 * u(gen)), Real(0.004 * u(gen)), Real(0.02 * u(gen)), Real(2e-4)};
+        user[i] = static_cast<unsigned>(n - 1 - i);
+    }
+    sphere::particle_view<Real> p{};
+    p.n = n;
+    p.x = x.data();
+    p.user = user.data();
+    sphere::neighbor_grid<Real, sphere::host> grid(g);
+    grid.build(p);
+    const sphere::grid_view<Real> v = grid.view();
+
+    std::vector<unsigned> below(g.cell_count() + 1, 0); // particles in cells lower than c
+    for (std::size_t i = 0; i < n; ++i) ++below[g.cell_of(x[i].xyz()) + 1];
+    for (std::size_t c = 1; c <= g.cell_count(); ++c) below[c] += below[c - 1];
+    std::size_t wrong = 0;
+    for (std::size_t c = 0; c <= g.cell_count(); ++c) wrong += v.cell_start[c] != below[c];
+    CHECK(wrong == 0);
+    CHECK(v.cell_start[g.cell_count()] == n);
+    // The sorted positions follow the order.
+    for (std::size_t k = 0; k < n; ++k) {
+        CHECK(v.sorted_x[k].z == x[v.order[k]].z);
+        if (k > 0) CHECK(g.cell_of(v.sorted_x[k - 1].xyz()) <= g.cell_of(v.sorted_x[k].xyz()));
+    }
+}

@@ -154,6 +154,13 @@ TEST_CASE("thread_governor obeys OMP_NUM_THREADS and SPHERE_ADAPT_THREADS=0", "[
         g.step();
         CHECK(sphere::host_team_limit() == 2);
     }
+    {
+        // Another simulation's governor has limited the thread to one: this one still adapts.
+        sphere::host_team_limit() = 1;
+        sphere::thread_governor g;
+        g.step();
+        CHECK(sphere::host_team_limit() == 2);
+    }
     CHECK(sphere::host_team_limit() == 0); // lifted when the governor goes
     if (omp) setenv("OMP_NUM_THREADS", saved.c_str(), 1);
 }

@@ -21,7 +21,9 @@
 
 #if SPHERE_CUDA_COMPILER
 #include <thrust/execution_policy.h>
+#include <thrust/functional.h>
 #include <thrust/iterator/counting_iterator.h>
+#include <thrust/iterator/reverse_iterator.h>
 #include <thrust/scan.h>
 #include <thrust/transform_reduce.h>
 #endif
@@ -62,6 +64,14 @@ inline std::size_t exclusive_scan_in_place(host, unsigned* values, std::size_t n
         sum += v;
     }
     return sum;
+}
+
+/// Replaces each values[i] by the least of values[i, n) (a suffix minimum). One pass on the
+/// calling thread: a store per value, cheaper than a parallel scan at the sizes it serves.
+inline void suffix_min_in_place(host, unsigned* values, std::size_t n)
+{
+    for (std::size_t i = n; i-- > 1;)
+        if (values[i] < values[i - 1]) values[i - 1] = values[i];
 }
 
 /// Returns init op f(0) op f(1) ... op f(n-1), in a fixed association order: in order within
@@ -111,6 +121,13 @@ inline std::size_t exclusive_scan_in_place(cuda, unsigned* values, std::size_t n
     unsigned before_last = 0;
     cudaMemcpy(&before_last, values + n - 1, sizeof before_last, cudaMemcpyDeviceToHost);
     return std::size_t(before_last) + last;
+}
+
+inline void suffix_min_in_place(cuda, unsigned* values, std::size_t n)
+{
+    if (n == 0) return;
+    const thrust::reverse_iterator<unsigned*> last_first(values + n);
+    thrust::inclusive_scan(thrust::device, last_first, last_first + n, last_first, thrust::minimum<unsigned>());
 }
 
 template <class T, class Transform, class Op>

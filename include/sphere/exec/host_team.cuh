@@ -17,15 +17,21 @@ inline int& host_team_limit()
     return limit;
 }
 
-/// The number of threads a host loop starts: OpenMP's count, capped by host_team_limit().
-inline int host_team()
+/// OpenMP's thread count for the calling thread (1 without OpenMP).
+inline int host_threads()
 {
 #ifdef _OPENMP
-    const int most = omp_get_max_threads(), limit = host_team_limit();
-    return limit > 0 && limit < most ? limit : most;
+    return omp_get_max_threads();
 #else
     return 1;
 #endif
+}
+
+/// The number of threads a host loop starts: host_threads(), capped by host_team_limit().
+inline int host_team()
+{
+    const int most = host_threads(), limit = host_team_limit();
+    return limit > 0 && limit < most ? limit : most;
 }
 
 } // namespace sphere

@@ -18,15 +18,14 @@ namespace sphere {
 
 /// The decision of thread_governor, apart from clocks: fed the wall time of every step, it
 /// answers the number of threads for the next one. It runs `window` steps on the current
-/// team, then `window` on the other (1 against all `most` threads; the first step of each
-/// window is not counted: it pays for waking the threads), and keeps the other when it took
-/// less time by `margin` (the other's window ends early once its time has passed that mark).
-/// Totals, not medians: on a busy machine most steps of a team are
-/// as fast as one thread's, and every few steps one waits milliseconds for a thread that
-/// shares its core; those waits are the cost. Then it runs `pause` steps before it compares again;
-/// the pause doubles while the choice holds (up to `longest_pause`) and restarts at
-/// `first_pause` after a switch, so a long run re-checks rarely and a change of load is
-/// followed within a few hundred steps.
+/// team, then up to `window` on the other (1 against all `most` threads), and switches when
+/// the other took less time by `margin`. The first step of each window is not counted (it
+/// pays for waking the threads), and a probe of the other team ends as soon as it has lost.
+/// Totals, not medians: on a busy machine most steps of a team are as fast as one thread's,
+/// and every few steps one waits milliseconds for a thread that shares its core; those waits
+/// are the cost. After a comparison it runs `pause` steps before the next; the pause doubles
+/// while the choice holds (up to `longest_pause`) and restarts at `first_pause` after a switch,
+/// so a long run re-checks rarely and a change of load is followed within a few thousand steps.
 class team_choice {
 public:
     static constexpr int window = 17;
@@ -53,7 +52,7 @@ public:
             break;
         case stage::other:
             // A probe ends as soon as it has lost: on a crowded machine a step on the other
-            // team can take 100 of the current team's.
+            // team can take 100 times as long as on the current one.
             if (book(seconds, other_) || other_ >= margin * current_) {
                 const bool switch_team = count_ == window && other_ < margin * current_;
                 if (!switch_team) team_ = other(); // back to the current team
@@ -97,7 +96,7 @@ private:
 /// OpenMP has one thread; `SPHERE_ADAPT_THREADS=0` turns it off too.
 class thread_governor {
 public:
-    thread_governor() : choice_(host_team()), on_(enabled()) {}
+    thread_governor() : choice_(host_threads()), on_(enabled()) {}
     thread_governor(const thread_governor&) = default;
     thread_governor(thread_governor&&) = default;
     thread_governor& operator=(const thread_governor&) = default;
@@ -124,7 +123,7 @@ private:
 
     static bool enabled()
     {
-        if (host_team() == 1 || std::getenv("OMP_NUM_THREADS") != nullptr) return false;
+        if (host_threads() == 1 || std::getenv("OMP_NUM_THREADS") != nullptr) return false;
         const char* adapt = std::getenv("SPHERE_ADAPT_THREADS");
         return adapt == nullptr || std::string_view(adapt) != "0";
     }

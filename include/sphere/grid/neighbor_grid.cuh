@@ -45,25 +45,23 @@ struct hash_particles {
     }
 };
 
-/// Sorted position k sets cell_start for every cell from its predecessor's key (exclusive)
-/// up to its own key (inclusive), so empty cells start where the next particle does; the
-/// sorted position one past the end closes the array. Each cell is written exactly once.
-template <class Real>
-struct find_cell_starts {
-    std::size_t n;
-    std::size_t cells;
+/// Sorted position k marks where its cell starts when it is the cell's first particle: each
+/// occupied cell is written once, by one particle (kernel over sorted positions).
+struct mark_cell_starts {
     const unsigned long long* key;
-    const unsigned* order;
-    const vec4<Real>* x;
-    vec4<Real>* sorted_x;
     unsigned* cell_start;
     SPHERE_HD void operator()(std::size_t k) const
     {
-        const std::size_t first = k == 0 ? 0 : std::size_t(key[k - 1] >> 32) + 1;
-        const std::size_t last = k == n ? cells : std::size_t(key[k] >> 32);
-        for (std::size_t c = first; c <= last; ++c) cell_start[c] = static_cast<unsigned>(k);
-        if (k < n) sorted_x[k] = x[order[k]];
+        const unsigned long long cell = key[k] >> 32;
+        if (k == 0 || (key[k - 1] >> 32) != cell) cell_start[cell] = static_cast<unsigned>(k);
     }
+};
+
+/// to[i] = value (kernel over the indices of `to`).
+struct fill_unsigned {
+    unsigned* to;
+    unsigned value;
+    SPHERE_HD void operator()(std::size_t i) const { to[i] = value; }
 };
 } // namespace detail
 
@@ -89,9 +87,13 @@ public:
         if (cell_start_.size() != cells + 1) cell_start_.resize(cells + 1);
         for_each_index(Policy{}, p.n, detail::hash_particles<Real>{geometry_, p.x, p.user, key_.data(), order_.data()});
         sort_by_key(Policy{}, key_.data(), order_.data(), p.n);
-        for_each_index(Policy{}, p.n + 1,
-                       detail::find_cell_starts<Real>{p.n, cells, key_.data(), order_.data(), p.x, sorted_x_.data(),
-                                                      cell_start_.data()});
+        // Where each cell starts: n everywhere, the first particle of each occupied cell marks
+        // it, and an empty cell takes the start of the next occupied one (a suffix minimum).
+        // Parallel over cells and particles, for any number of empty cells (a tall box).
+        for_each_index(Policy{}, cells + 1, detail::fill_unsigned{cell_start_.data(), static_cast<unsigned>(p.n)});
+        for_each_index(Policy{}, p.n, detail::mark_cell_starts{key_.data(), cell_start_.data()});
+        suffix_min_in_place(Policy{}, cell_start_.data(), cells + 1);
+        for_each_index(Policy{}, p.n, detail::gather<vec4<Real>>{p.x, order_.data(), sorted_x_.data()});
     }
 
     /// The storage of the sorted positions, for a caller that no longer needs them until the
