@@ -10,10 +10,6 @@
 #include <utility>
 #include <vector>
 
-#ifdef _OPENMP
-#include <omp.h>
-#endif
-
 #include "analysis/energy.cuh"
 #include "boundary/wall_control.cuh"
 #include "boundary/walls.cuh"
@@ -539,7 +535,8 @@ private:
             finish_step<Book, Record>(body, loads, moved2);
         } else {
             finish_step<Book, Record>(integrate, loads, moved2);
-        }        advance_walls(walls_, settings_.walls, settings_.box, loads.force, time_, dt_, steps_ + 1);
+        }
+        advance_walls(walls_, settings_.walls, settings_.box, loads.force, time_, dt_, steps_ + 1);
         if (drive_)
             drive_work_ += transform_reduce(Policy{}, n,
                                             detail::by_rank<detail::drive_power<Precision>, Real>{{p, gravity_},
@@ -565,7 +562,7 @@ private:
         if constexpr (std::is_same_v<Policy, host>) {
             const std::size_t count = lists_.wall_particles();
             wall_loads_.assign(count, detail::wall_loads{{0, 0, 0, 0, 0, 0}});
-            std::vector<Coord> moved(std::size_t(max_threads()), Coord(0));
+            std::vector<Coord> moved(std::size_t(host_threads()), Coord(0));
             const detail::finish_block<Precision, decltype(walls), Body, check_here> finish{
                 walls, body, check(), lists_.view(), lists_.wall_ranks(), count, wall_loads_.data(), moved.data()};
             if (interaction_.template sum_pairs<Book, Record>(pair_contact(), lists_, summation_, true, finish)) {
@@ -580,15 +577,6 @@ private:
                                  plus_op{});
         if constexpr (check_here) moved2 = checked(body);
         else for_each_index(Policy{}, particles_.size(), body);
-    }
-
-    static int max_threads()
-    {
-#ifdef _OPENMP
-        return omp_get_max_threads();
-#else
-        return 1;
-#endif
     }
 
     /// The forces of the current positions, leaving the contacts' histories and the energy

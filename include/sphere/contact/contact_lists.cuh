@@ -37,12 +37,19 @@ namespace sphere {
 /// below it.
 inline constexpr unsigned wall_partner_base = 0xFFFFFFF0u;
 
-/// A contact's history as seen from its other particle: the tangential displacement reversed,
-/// the sliding flag kept.
+/// A contact's history or recorded force as seen from its other particle: the tangential part
+/// (xyz: displacement or force) reversed, w (sliding flag, or f_n . n) kept.
 template <class Real>
-SPHERE_HDI vec4<Real> mirrored_history(const vec4<Real>& h)
+SPHERE_HDI vec4<Real> mirrored(const vec4<Real>& h)
 {
     return {-h.x, -h.y, -h.z, h.w};
+}
+
+/// Whether an entry has a history to pass on (a contact that touched at the last step).
+template <class Real>
+SPHERE_HDI bool has_history(const vec4<Real>& h)
+{
+    return h.x != Real(0) || h.y != Real(0) || h.z != Real(0) || h.w != Real(0);
 }
 
 /// Kernel view of the contact lists.
@@ -262,7 +269,7 @@ struct fill_entries {
                 old.find(me, code, h);
             } else {
                 const unsigned them = order[code];
-                if (!old.find(me, them, h) && old.find(them, me, h)) h = mirrored_history(h);
+                if (!old.find(me, them, h) && old.find(them, me, h)) h = mirrored(h);
                 p[a] = keep_order ? them : code;
             }
             history[begin + a] = h;
@@ -279,10 +286,7 @@ struct count_histories {
     SPHERE_HD void operator()(std::size_t r) const
     {
         unsigned c = 0;
-        for (unsigned e = offset[r]; e < offset[r + 1]; ++e) {
-            const vec4<Real> h = history[e];
-            c += h.x != Real(0) || h.y != Real(0) || h.z != Real(0) || h.w != Real(0);
-        }
+        for (unsigned e = offset[r]; e < offset[r + 1]; ++e) c += has_history(history[e]);
         count[r] = c;
     }
 };
@@ -300,10 +304,9 @@ struct copy_histories {
     {
         unsigned k = to_offset[r];
         for (unsigned e = offset[r]; e < offset[r + 1]; ++e) {
-            const vec4<Real> h = history[e];
-            if (h.x != Real(0) || h.y != Real(0) || h.z != Real(0) || h.w != Real(0)) {
+            if (has_history(history[e])) {
                 to_partner[k] = partner[e];
-                to_history[k] = h;
+                to_history[k] = history[e];
                 ++k;
             }
         }
@@ -458,11 +461,10 @@ public:
         for (const item& it : items) {
             t.partner.push_back(it.partner);
             const vec4<Real> h = hist[it.entry];
-            t.history.push_back(vec_cast<Coord>(it.mirrored ? mirrored_history(h) : h));
+            t.history.push_back(vec_cast<Coord>(it.mirrored ? mirrored(h) : h));
             if (record_forces_) {
                 const vec4<Real> f = frc[it.entry];
-                // the partner feels the opposite tangential force; f_n . n is the same
-                t.force.push_back(vec_cast<Coord>(it.mirrored ? vec4<Real>{-f.x, -f.y, -f.z, f.w} : f));
+                t.force.push_back(vec_cast<Coord>(it.mirrored ? mirrored(f) : f));
             }
         }
         return t;

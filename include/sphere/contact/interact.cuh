@@ -377,21 +377,6 @@ struct reverse_keys {
     }
 };
 
-/// From keys sorted ascending (values up to n, larger ones counted as n), start[v] = the first
-/// position whose key is at least v, for v = 0 .. n (one index per position and one past the end).
-struct key_starts {
-    std::size_t count, n;
-    const unsigned* key;
-    unsigned* start;
-    SPHERE_HD void operator()(std::size_t k) const
-    {
-        const std::size_t first = k == 0 ? 0 : clamp(key[k - 1]) + 1;
-        const std::size_t last = k == count ? n : clamp(key[k]);
-        for (std::size_t v = first; v <= last; ++v) start[v] = static_cast<unsigned>(k);
-    }
-    SPHERE_HD std::size_t clamp(unsigned v) const { return v < n ? v : n; }
-};
-
 } // namespace detail
 
 /// Sums the pair contacts into the particles' forces and torques (and, with Book, their audit
@@ -463,7 +448,7 @@ private:
         reverse_offset_.resize(n + 1);
         for_each_index(Policy{}, entries, detail::reverse_keys<Real>{c, key.data(), reverse_entry_.data()});
         sort_by_key(Policy{}, key.data(), reverse_entry_.data(), entries);
-        for_each_index(Policy{}, entries + 1, detail::key_starts{entries, n, key.data(), reverse_offset_.data()});
+        find_starts(Policy{}, key.data(), entries, n, reverse_offset_.data()); // walls (key ~0) count as n
         reverse_ready_ = true;
     }
 

@@ -138,4 +138,45 @@ T transform_reduce(cuda, std::size_t n, const Transform& f, T init, Op op)
 }
 #endif
 
+namespace detail {
+/// to[i] = value (kernel over the indices of `to`).
+struct fill_unsigned {
+    unsigned* to;
+    unsigned value;
+    SPHERE_HD void operator()(std::size_t i) const { to[i] = value; }
+};
+
+/// Position k of sorted keys marks where its value (key >> Shift, at most n) starts when it is
+/// the first position with that value: each value present is written once.
+template <class Key, int Shift>
+struct mark_starts {
+    const Key* key;
+    std::size_t n;
+    unsigned* start;
+    SPHERE_HD std::size_t value(std::size_t k) const
+    {
+        const std::size_t v = static_cast<std::size_t>(key[k] >> Shift);
+        return v < n ? v : n;
+    }
+    SPHERE_HD void operator()(std::size_t k) const
+    {
+        const std::size_t v = value(k);
+        if (k == 0 || value(k - 1) != v) start[v] = static_cast<unsigned>(k);
+    }
+};
+} // namespace detail
+
+/// From `count` keys sorted ascending, read as values key >> Shift (values of n or more count
+/// as n), sets start[v] for v = 0 .. n to the first position whose value is at least v (count
+/// when there is none). Every start is set to count, the first position of each value present
+/// marks it, and a suffix minimum gives each absent value the next present one's start: no
+/// thread walks a run of absent values, however many there are.
+template <int Shift = 0, class Policy, class Key>
+void find_starts(Policy, const Key* key, std::size_t count, std::size_t n, unsigned* start)
+{
+    for_each_index(Policy{}, n + 1, detail::fill_unsigned{start, static_cast<unsigned>(count)});
+    for_each_index(Policy{}, count, detail::mark_starts<Key, Shift>{key, n, start});
+    suffix_min_in_place(Policy{}, start, n + 1);
+}
+
 } // namespace sphere

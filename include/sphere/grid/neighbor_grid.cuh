@@ -45,24 +45,6 @@ struct hash_particles {
     }
 };
 
-/// Sorted position k marks where its cell starts when it is the cell's first particle: each
-/// occupied cell is written once, by one particle (kernel over sorted positions).
-struct mark_cell_starts {
-    const unsigned long long* key;
-    unsigned* cell_start;
-    SPHERE_HD void operator()(std::size_t k) const
-    {
-        const unsigned long long cell = key[k] >> 32;
-        if (k == 0 || (key[k - 1] >> 32) != cell) cell_start[cell] = static_cast<unsigned>(k);
-    }
-};
-
-/// to[i] = value (kernel over the indices of `to`).
-struct fill_unsigned {
-    unsigned* to;
-    unsigned value;
-    SPHERE_HD void operator()(std::size_t i) const { to[i] = value; }
-};
 } // namespace detail
 
 template <class Real, class Policy>
@@ -87,12 +69,9 @@ public:
         if (cell_start_.size() != cells + 1) cell_start_.resize(cells + 1);
         for_each_index(Policy{}, p.n, detail::hash_particles<Real>{geometry_, p.x, p.user, key_.data(), order_.data()});
         sort_by_key(Policy{}, key_.data(), order_.data(), p.n);
-        // Where each cell starts: n everywhere, the first particle of each occupied cell marks
-        // it, and an empty cell takes the start of the next occupied one (a suffix minimum).
-        // Parallel over cells and particles, for any number of empty cells (a tall box).
-        for_each_index(Policy{}, cells + 1, detail::fill_unsigned{cell_start_.data(), static_cast<unsigned>(p.n)});
-        for_each_index(Policy{}, p.n, detail::mark_cell_starts{key_.data(), cell_start_.data()});
-        suffix_min_in_place(Policy{}, cell_start_.data(), cells + 1);
+        // where each cell starts, for any number of empty cells (a tall box); the cell is the
+        // key's high 32 bits
+        find_starts<32>(Policy{}, key_.data(), p.n, cells, cell_start_.data());
         for_each_index(Policy{}, p.n, detail::gather<vec4<Real>>{p.x, order_.data(), sorted_x_.data()});
     }
 
