@@ -137,6 +137,7 @@ int run(const options& o, const bed_file& b)
     s.skin = Real(skin);
     s.contact_forces = o.audit; // the scenario reads neither the contact forces nor the dissipation
     s.energy_audit = o.audit;
+    s.angular_position = false; // nor the rotation angles
 
     const std::size_t per_tile = b.x.size();
     std::vector<std::size_t> order(per_tile * tx * ty);

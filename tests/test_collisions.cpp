@@ -695,6 +695,58 @@ TEMPLATE_TEST_CASE("D6: oblique impact on a wall, sliding", "[collision][D6]", f
     }
 }
 
+TEMPLATE_TEST_CASE("angular position: the time integral of the angular velocity", "[collision][angular_position]",
+                   float, double, sphere::mixed)
+{
+    using P = TestType;
+    using Real = user_real<P>;
+    // The D6 impact: omega_y grows from 0 to 1.5 rad/s while the sphere slides on the floor,
+    // then stays. The angular position is sum omega(t_k) dt over the steps (semi-implicit
+    // Euler: the angular velocity each step has just set), which the test adds up in double
+    // from the snapshots; with velocity Verlet it is the mid-step omega, which the test cannot
+    // see: only the free spin after the impact is checked, phi_y(t2) - phi_y(t1) =
+    // omega_y (t2 - t1). Tolerance: the rounding of the field's own sum of 2000 terms, at
+    // most 2000 x 6e-8 = 1.2e-4 in float fields, 1e-10 in double.
+    const Real r_p = set_p<Real>::radius;
+    const double tol = sphere_test::single_fields<P> ? 1.2e-4 : 1e-10;
+    sphere::settings<Real> s = box_settings<Real>();
+    s.box.lo.z = -r_p;
+    s.wall.gamma_n = 0;
+    s.wall.gamma_t = Real(100);
+    s.wall.mu_s = s.wall.mu_d = Real(0.3);
+    s.dt = Real(dt_p);
+    const std::vector<sphere::particle<Real>> ball_on_floor{ball<Real>({0, 0, 0}, {Real(0.05), 0, Real(-0.01)})};
+    const std::size_t steps = 2000;
+    SECTION("semi-implicit Euler: every step")
+    {
+        host_sim<P> sim(s, ball_on_floor);
+        double phi = 0;
+        for (std::size_t k = 0; k < steps; ++k) {
+            sim.step();
+            phi += double(sim.snapshot().omega[0].y) * double(sim.dt());
+        }
+        const auto snap = sim.snapshot();
+        INFO("phi_y = " << double(snap.angpos[0].y) << " rad, sum of omega_y dt = " << phi << " rad");
+        CHECK(double(snap.omega[0].y) > 1.4); // it did spin up
+        CHECK(rel_err(snap.angpos[0].y, phi) < tol);
+        CHECK(snap.angpos[0].x == 0);
+        CHECK(snap.angpos[0].z == 0);
+    }
+    SECTION("velocity Verlet: the free spin after the impact")
+    {
+        sphere::simulation<P, sphere::host, sphere::contact::linear<>, sphere::integrate::velocity_verlet> sim(
+            s, ball_on_floor);
+        sim.run(steps / 2);
+        const auto before = sim.snapshot();
+        sim.run(steps / 2);
+        const auto after = sim.snapshot();
+        REQUIRE(after.omega[0].y == before.omega[0].y); // off the floor: omega stays
+        const double turned = double(after.angpos[0].y) - double(before.angpos[0].y);
+        INFO("turned " << turned << " rad at omega_y = " << double(after.omega[0].y) << " rad/s");
+        CHECK(rel_err(turned, double(after.omega[0].y) * double(sim.dt()) * double(steps / 2)) < tol);
+    }
+}
+
 // ---------------------------------------------------------------------------------------------
 // Mass-scaled damping (damping_convention::mass_scaled): c = gamma m* per contact.
 // ---------------------------------------------------------------------------------------------

@@ -324,6 +324,51 @@ TEMPLATE_TEST_CASE("the storage order does not change the physics: reordering on
     SECTION("velocity Verlet") { compare(sphere::integrate::velocity_verlet{}); }
 }
 
+TEMPLATE_TEST_CASE("switching off what a run does not read (audit, contact forces, angular positions) keeps the motion's bits",
+                   "[determinism][memory]", float, double, sphere::mixed)
+{
+    using P = TestType;
+    using Real = sphere_test::user_real<P>;
+    // settings.energy_audit, contact_forces and angular_position only decide what is booked
+    // and allocated besides the motion: with all three off, positions, velocities, forces,
+    // contact lists and histories are the same bits, and the fields that are not kept read
+    // zero (or, for the contact forces, are absent).
+    const auto setup = assembly<Real>(9, Real(0.002), 23); // 729 particles, skin 0.2 r0
+    auto compare = [&](auto integrator) {
+        using Integrator = decltype(integrator);
+        using sim_type = sphere::simulation<P, sphere::host, sphere::contact::linear<>, Integrator>;
+        sphere::settings<Real> lean = setup.first;
+        lean.energy_audit = lean.contact_forces = lean.angular_position = false;
+        sim_type full(setup.first, setup.second), trimmed(lean, setup.second);
+        full.run(250);
+        trimmed.run(250);
+        const auto a = record_of(full), b = record_of(trimmed);
+        require_eventful(a);
+        CHECK(full.rebuilds() > 2);
+        std::vector<std::string> diff = differences(a, b);
+        const std::vector<std::string> not_kept{"angpos",   "pressure", "e_visc", "e_fric",
+                                                "p_visc",   "p_fric",   "contact forces", "energy budget"};
+        for (const std::string& f : not_kept) diff.erase(std::remove(diff.begin(), diff.end(), f), diff.end());
+        INFO("fields that differ: " << Catch::Detail::stringify(diff));
+        CHECK(diff.empty());
+        // What is not kept reads zero; the full run really has it.
+        auto zero = [](const std::vector<Real>& values) {
+            return std::all_of(values.begin(), values.end(), [](Real v) { return v == Real(0); });
+        };
+        double turned = 0;
+        for (const auto& w : a.snap.angpos) turned = std::max(turned, double(sphere::norm(w)));
+        CHECK(turned > 0.1); // rad
+        for (const auto& w : b.snap.angpos) REQUIRE(sphere::norm(w) == Real(0));
+        CHECK(zero(b.snap.e_visc));
+        CHECK(zero(b.snap.pressure));
+        CHECK(!zero(a.snap.e_visc));
+        CHECK(b.contacts.force.empty());
+        CHECK(a.contacts.force.size() == a.contacts.partner.size());
+    };
+    SECTION("semi-implicit Euler") { compare(sphere::integrate::semi_implicit_euler{}); }
+    SECTION("velocity Verlet") { compare(sphere::integrate::velocity_verlet{}); }
+}
+
 TEMPLATE_TEST_CASE("a state continues bit for bit in a simulation that stores its particles in another order",
                    "[determinism][reorder][restart]", float, double, sphere::mixed)
 {

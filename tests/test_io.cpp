@@ -397,10 +397,10 @@ TEMPLATE_TEST_CASE("broken checkpoints raise the documented errors", "[io][check
         };
         const std::uint64_t n = 64, entries = sim.state().contacts.partner.size();
         CHECK(bytes.compare(0, 8, "SPHERECK") == 0);
-        CHECK(u32_at(8) == 3);
+        CHECK(u32_at(8) == 4);
         CHECK(u32_at(12) == sizeof(Real));
         CHECK(u64_at(16) == size - 32);
-        CHECK(size == 1032 + 289 * n + 36 * entries);
+        CHECK(size == 1036 + 289 * n + 36 * entries);
         CHECK(f64_at(24 + 40) == double(sim.config().box.hi.z)); // box.hi = payload bytes 24-47
         CHECK(u32_at(24 + 48) == 0); // box.axis[0]: wall
         CHECK(f64_at(24 + 60) == double(sim.config().contact.k_n));
@@ -410,17 +410,18 @@ TEMPLATE_TEST_CASE("broken checkpoints raise the documented errors", "[io][check
         CHECK(f64_at(24 + 204) == double(sim.config().skin));
         CHECK(u32_at(24 + 212) == 1); // contact_forces
         CHECK(u32_at(24 + 216) == 1); // energy_audit
-        CHECK(u32_at(24 + 228 + 5 * 52) == 2); // walls[5].mode: stress
-        CHECK(f64_at(24 + 228 + 5 * 52 + 4 + 16) == double(sim.config().walls[5].amplitude));
-        CHECK(u64_at(24 + 540) == n);
-        CHECK(u64_at(24 + 548) == 100); // steps
-        CHECK(u64_at(24 + 556) == sim.rebuilds());
-        CHECK(u32_at(24 + 568 + 5 * 36) == 1); // face 5 active
-        CHECK(f64_at(24 + 568 + 5 * 36 + 4) == double(sim.walls().face[5].position));
-        CHECK(f64_at(24 + 784 + 5 * 8) == double(sim.state().walls_at_build.face[5].position));
-        CHECK(f64_at(24 + 832) == sim.drive_work());
-        CHECK(u64_at(24 + 840) == n); // the positions' count
-        CHECK(f64_at(24 + 840 + 8 + 3 * 8) == double(sim.snapshot().x[0].w)); // particle 0's radius
+        CHECK(u32_at(24 + 220) == 1); // angular_position
+        CHECK(u32_at(24 + 232 + 5 * 52) == 2); // walls[5].mode: stress
+        CHECK(f64_at(24 + 232 + 5 * 52 + 4 + 16) == double(sim.config().walls[5].amplitude));
+        CHECK(u64_at(24 + 544) == n);
+        CHECK(u64_at(24 + 552) == 100); // steps
+        CHECK(u64_at(24 + 560) == sim.rebuilds());
+        CHECK(u32_at(24 + 572 + 5 * 36) == 1); // face 5 active
+        CHECK(f64_at(24 + 572 + 5 * 36 + 4) == double(sim.walls().face[5].position));
+        CHECK(f64_at(24 + 788 + 5 * 8) == double(sim.state().walls_at_build.face[5].position));
+        CHECK(f64_at(24 + 836) == sim.drive_work());
+        CHECK(u64_at(24 + 844) == n); // the positions' count
+        CHECK(f64_at(24 + 844 + 8 + 3 * 8) == double(sim.snapshot().x[0].w)); // particle 0's radius
     }
     SECTION("missing")
     {
@@ -475,11 +476,11 @@ TEMPLATE_TEST_CASE("broken checkpoints raise the documented errors", "[io][check
     SECTION("wrong version")
     {
         std::string b = bytes;
-        REQUIRE(b[8] == 3); // the version, little-endian u32 at byte 8
-        b[8] = 2;
+        REQUIRE(b[8] == 4); // the version, little-endian u32 at byte 8
+        b[8] = 3;
         write_bytes(bad, b);
         REQUIRE_THROWS_WITH(sphere::read_checkpoint<Real>(bad),
-                            where + "format version 2, but this build reads version 3 only");
+                            where + "format version 3, but this build reads version 4 only");
     }
     SECTION("sizes that do not fit the particle count")
     {

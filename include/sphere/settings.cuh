@@ -27,6 +27,10 @@ struct settings {
     /// step, so that energy().total() closes; off leaves them at zero, saves their work and
     /// does not allocate their five arrays (40 B per particle in double).
     bool energy_audit = true;
+    /// Integrate each particle's angular position (rad; the VTK field angular_position, as the
+    /// original sphere); off leaves it at zero and does not allocate it (24 B per particle in
+    /// double).
+    bool angular_position = true;
     /// Store the particles in the neighbour grid's cell order, permuted at every rebuild (nearby
     /// particles sit nearby in memory: about 2x faster on a large, spatially unsorted input);
     /// false keeps the user's order. Results are the same bits either way: every sum follows

@@ -224,16 +224,18 @@ public:
         dt_ = Coord(Real(dt_)); // the kernels step velocities with dt in Real: one dt throughout
 
         particles_ = particle_state<Precision, Policy>(particles, Integrator::distinct_synchronous_velocity,
-                                                       s.energy_audit);
+                                                       s.energy_audit, s.angular_position);
         for (const particle<Coord>& p : particles) {
             kinds_.push_back(p.kind);
             if (p.kind == motion::prescribed || p.kind == motion::prescribed_horizontal) drive_ = true;
         }
+        const std::size_t n = particles.size();
+        std::vector<particle<Coord>>().swap(particles); // copied: its memory is not held through the first build
         walls_ = wall_set<Coord>::from_world(s.box);
         grid_ = neighbor_grid<Coord, Policy>(grid_geometry<Coord>::make(s.box, 2 * max_radius + s.skin, s.cell_size));
-        lists_ = contact_lists<Precision, Policy>(particles.size(), s.contact_forces);
+        lists_ = contact_lists<Precision, Policy>(n, s.contact_forces);
         summation_ = interaction<Precision, Policy>::resolve(s.pair_summation);
-        x_at_build_.resize(particles.size());
+        x_at_build_.resize(n);
         rebuild_lists();
         // An integrator that kicks before the forces needs the forces of the start.
         if (Integrator::drifts_before_forces)
@@ -433,7 +435,7 @@ public:
         at_build.n = size();
         at_build.x = x_build.data();
         at_build.user = users.data();
-        grid_.build(at_build);
+        grid_.build(at_build, x_at_build_.data()); // set below
         const grid_view<Coord> g = grid_.view();
         const std::vector<unsigned> before = particles_.user_indices();
         std::vector<unsigned> storage = identity;
@@ -483,17 +485,20 @@ private:
     /// user index) and permutes every per-particle array into the grid's cell order.
     void rebuild_lists()
     {
-        grid_.build(particles_.view());
+        // The positions of this rebuild in rank order go straight into x_at_build_: the lists
+        // are built from them, and once the particles are stored in rank order they are the
+        // positions at the rebuild of each slot.
+        grid_.build(particles_.view(), x_at_build_.data());
         const grid_view<Coord> g = grid_.view();
         lists_.rebuild(g, walls_, settings_.skin, !settings_.reorder);
         interaction_.lists_changed();
         if (settings_.reorder) {
-            vec4<Coord>* scratch = grid_.reusable_positions(); // the lists are built: free to reuse
-            particles_.permute(g.order, scratch);
-            if (external_.size()) particles_.permute_along(external_, g.order, scratch);
+            particles_.permute(g.order, x_at_build_.data());
+            if (external_.size()) particles_.permute_along(external_, g.order);
+        } else {
+            const particle_view<Precision> p = particles_.view();
+            for_each_index(Policy{}, p.n, detail::copy_positions<Coord>{p.x, x_at_build_.data()});
         }
-        const particle_view<Precision> p = particles_.view();
-        for_each_index(Policy{}, p.n, detail::copy_positions<Coord>{p.x, x_at_build_.data()});
         walls_at_build_ = walls_;
         ++rebuilds_;
         needs_rebuild_ = false;
@@ -523,10 +528,12 @@ private:
         constexpr bool drifted = Integrator::drifts_before_forces;
         const detail::integrate_particles<Precision, Integrator, External> integrate{p, settings_.box, gravity_,
                                                                                    Real(dt_), external};
-        if constexpr (drifted)
+        if constexpr (drifted) {
             judge(checked(detail::drift_particles<Precision, Integrator, External>{p, settings_.box, gravity_, Real(dt_),
                                                                                   external}),
                   steps_ + 1);
+            turn();
+        }
         if (needs_rebuild_) rebuild_lists();
         detail::wall_loads loads{{0, 0, 0, 0, 0, 0}};
         Coord moved2 = 0;
@@ -536,6 +543,7 @@ private:
         } else {
             finish_step<Book, Record>(integrate, loads, moved2);
         }
+        if constexpr (!drifted) turn();
         advance_walls(walls_, settings_.walls, settings_.box, loads.force, time_, dt_, steps_ + 1);
         if (drive_)
             drive_work_ += transform_reduce(Policy{}, n,
@@ -577,6 +585,14 @@ private:
                                  plus_op{});
         if constexpr (check_here) moved2 = checked(body);
         else for_each_index(Policy{}, particles_.size(), body);
+    }
+
+    /// Advances the angular positions (settings.angular_position) with the angular velocities
+    /// the step has just set.
+    void turn()
+    {
+        const particle_view<Precision> p = particles_.view();
+        if (p.angpos) for_each_index(Policy{}, p.n, detail::turn_particles<Precision>{p, Real(dt_)});
     }
 
     /// The forces of the current positions, leaving the contacts' histories and the energy

@@ -140,9 +140,10 @@ T transform_reduce(cuda, std::size_t n, const Transform& f, T init, Op op)
 
 namespace detail {
 /// to[i] = value (kernel over the indices of `to`).
-struct fill_unsigned {
-    unsigned* to;
-    unsigned value;
+template <class T>
+struct fill_value {
+    T* to;
+    T value;
     SPHERE_HD void operator()(std::size_t i) const { to[i] = value; }
 };
 
@@ -174,7 +175,7 @@ struct mark_starts {
 template <int Shift = 0, class Policy, class Key>
 void find_starts(Policy, const Key* key, std::size_t count, std::size_t n, unsigned* start)
 {
-    for_each_index(Policy{}, n + 1, detail::fill_unsigned{start, static_cast<unsigned>(count)});
+    for_each_index(Policy{}, n + 1, detail::fill_value<unsigned>{start, static_cast<unsigned>(count)});
     for_each_index(Policy{}, count, detail::mark_starts<Key, Shift>{key, n, start});
     suffix_min_in_place(Policy{}, start, n + 1);
 }

@@ -55,16 +55,25 @@ public:
     const grid_geometry<Real>& geometry() const { return geometry_; }
 
     /// Rebuilds the cell lists from the particles' current positions (held in Real: a grid
-    /// is laid in the type of the positions, coord_t of the particles' precision P).
+    /// is laid in the type of the positions, coord_t of the particles' precision P). The
+    /// positions in sorted order go to `sorted_into` (p.n elements of policy memory that the
+    /// caller owns and keeps unchanged while it uses the view) or, without it, to the grid's
+    /// own array.
     template <class P>
-    void build(const particle_view<P>& p)
+    void build(const particle_view<P>& p, vec4<Real>* sorted_into = nullptr)
     {
         static_assert(std::is_same_v<coord_t<P>, Real>, "the grid is laid in the type of the positions");
         const std::size_t cells = geometry_.cell_count();
         if (key_.size() != p.n) {
             key_.resize(p.n);
             order_.resize(p.n);
-            sorted_x_.resize(p.n);
+        }
+        if (sorted_into) {
+            own_sorted_x_ = buffer<vec4<Real>, Policy>();
+            sorted_x_ = sorted_into;
+        } else {
+            own_sorted_x_.resize(p.n);
+            sorted_x_ = own_sorted_x_.data();
         }
         if (cell_start_.size() != cells + 1) cell_start_.resize(cells + 1);
         for_each_index(Policy{}, p.n, detail::hash_particles<Real>{geometry_, p.x, p.user, key_.data(), order_.data()});
@@ -72,24 +81,20 @@ public:
         // where each cell starts, for any number of empty cells (a tall box); the cell is the
         // key's high 32 bits
         find_starts<32>(Policy{}, key_.data(), p.n, cells, cell_start_.data());
-        for_each_index(Policy{}, p.n, detail::gather<vec4<Real>>{p.x, order_.data(), sorted_x_.data()});
+        for_each_index(Policy{}, p.n, detail::gather<vec4<Real>>{p.x, order_.data(), sorted_x_});
     }
-
-    /// The storage of the sorted positions, for a caller that no longer needs them until the
-    /// next build: the simulation permutes the particles through it once the contact lists are
-    /// built (one array fewer per particle). Invalidates view().sorted_x.
-    vec4<Real>* reusable_positions() { return sorted_x_.data(); }
 
     grid_view<Real> view() const
     {
-        return {geometry_, key_.size(), order_.data(), sorted_x_.data(), cell_start_.data()};
+        return {geometry_, key_.size(), order_.data(), sorted_x_, cell_start_.data()};
     }
 
 private:
     grid_geometry<Real> geometry_;
     buffer<unsigned long long, Policy> key_;
     buffer<unsigned, Policy> order_, cell_start_;
-    buffer<vec4<Real>, Policy> sorted_x_;
+    buffer<vec4<Real>, Policy> own_sorted_x_; ///< empty when the caller holds the sorted positions
+    vec4<Real>* sorted_x_ = nullptr;
 };
 
 } // namespace sphere

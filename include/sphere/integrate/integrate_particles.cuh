@@ -84,15 +84,14 @@ struct integrate_particles {
         const auto kind = static_cast<motion>(p.kind[i]);
         vec4<Coord> x = p.x[i]; // aggregates not const: see the note in contact/evaluate.cuh
         vec3<Coord> pos = x.xyz();
-        vec3<Real> v = p.v[i], w = p.omega[i], ang = drifted ? vec3<Real>{0, 0, 0} : p.angpos[i];
+        vec3<Real> v = p.v[i], w = p.omega[i], angle{0, 0, 0}; // angles are turn_particles' (not stored here)
         vec3<Real> a, alpha;
         accelerations<External>(p, i, kind, gravity, external, a, alpha);
         Integrator::advance(pos, v, a, dt);
-        Integrator::advance(ang, w, alpha, dt);
+        Integrator::advance(angle, w, alpha, dt);
         if (!drifted) {
             pos = wrapped(box, pos);
             p.x[i] = {pos.x, pos.y, pos.z, x.w};
-            p.angpos[i] = ang;
         }
         p.v[i] = v;
         p.omega[i] = w;
@@ -123,17 +122,29 @@ struct drift_particles {
         const auto kind = static_cast<motion>(p.kind[i]);
         vec4<Coord> x = p.x[i];
         vec3<Coord> pos = x.xyz();
-        vec3<Real> v = p.v[i], w = p.omega[i], ang = p.angpos[i];
+        vec3<Real> v = p.v[i], w = p.omega[i], angle{0, 0, 0}; // angles are turn_particles' (not stored here)
         vec3<Real> a, alpha;
         accelerations<External>(p, i, kind, gravity, external, a, alpha);
         Integrator::drift(pos, v, a, dt);
-        Integrator::drift(ang, w, alpha, dt);
+        Integrator::drift(angle, w, alpha, dt);
         pos = wrapped(box, pos);
         p.x[i] = {pos.x, pos.y, pos.z, x.w};
         p.v[i] = v;
         p.omega[i] = w;
-        p.angpos[i] = ang;
     }
+};
+
+/// Advances particle i's angular position by omega dt, with the angular velocity that the
+/// step has just set (semi-implicit Euler's rule; velocity Verlet's mid-step angular velocity
+/// when run after its drift): a pass of its own, run only with settings.angular_position,
+/// so that the motion's kernels neither load nor store angles (docs/physics.md, "Angular
+/// position").
+template <class P>
+struct turn_particles {
+    using Real = real_t<P>;
+    particle_view<P> p;
+    Real dt;
+    SPHERE_HDI void operator()(std::size_t i) const { p.angpos[i] += p.omega[i] * dt; }
 };
 
 /// The post-step check of particle i: the squared displacement since the contact lists were

@@ -43,7 +43,7 @@
 namespace sphere {
 
 /// The checkpoint format version this build writes, and the only one it reads.
-inline constexpr std::uint32_t checkpoint_format_version = 3;
+inline constexpr std::uint32_t checkpoint_format_version = 4;
 
 /// The first 8 bytes of every checkpoint.
 inline constexpr char checkpoint_magic[9] = "SPHERECK";
@@ -284,6 +284,7 @@ std::string encode_checkpoint(const settings<Real>& config, Real dt, const simul
     e.f64(double(config.skin));
     e.u32(config.contact_forces ? 1u : 0u);
     e.u32(config.energy_audit ? 1u : 0u);
+    e.u32(config.angular_position ? 1u : 0u);
     e.f64(double(config.cell_size));
     for (const wall_control<Real>& c : config.walls) {
         e.u32(static_cast<std::uint32_t>(c.mode));
@@ -394,6 +395,7 @@ checkpoint_data<Real> decode_checkpoint(const std::string& bytes, const std::str
     s.skin = Real(d.f64("settings.skin"));
     s.contact_forces = d.choice("settings.contact_forces", 1) == 1;
     s.energy_audit = d.choice("settings.energy_audit", 1) == 1;
+    s.angular_position = d.choice("settings.angular_position", 1) == 1;
     s.cell_size = Real(d.f64("settings.cell_size"));
     for (wall_control<Real>& w : s.walls) {
         w.mode = static_cast<wall_mode>(d.choice("settings.walls[].mode", 2));

@@ -13,6 +13,7 @@
 #include "../core/constants.cuh"
 #include "../core/precision.cuh"
 #include "../core/vec.cuh"
+#include "../exec/algorithms.cuh"
 #include "../exec/buffer.cuh"
 #include "../exec/for_each.cuh"
 #include "particle.cuh"
@@ -32,7 +33,7 @@ struct particle_view {
     vec3<Real>* omega;      ///< angular velocity (rad/s)
     vec3<Real>* v_sync;     ///< velocity at the time of the positions (m/s), seen by contact laws
     vec3<Real>* omega_sync; ///< angular velocity at the time of the positions (rad/s)
-    vec3<Real>* angpos;     ///< integrated angular position (rad)
+    vec3<Real>* angpos;     ///< integrated angular position (rad); null without settings.angular_position
     vec3<Real>* force;      ///< sum of contact forces of the last step (N), without gravity
     vec3<Real>* torque;     ///< sum of contact torques of the last step (N m)
     Real* mass;             ///< (kg)
@@ -101,9 +102,10 @@ public:
     /// velocities at the positions' time are the velocities themselves (every integrator but
     /// semi-implicit Euler): v_sync and omega_sync then share v's and omega's arrays. Without
     /// `audit` there are no energy-audit arrays (pressure, dissipation): snapshots show zeros.
+    /// Without `angular_position` there is no angular-position array (snapshots show zeros).
     explicit particle_state(const std::vector<particle<Coord>>& particles, bool distinct_sync = true,
-                            bool audit = true)
-        : distinct_sync_(distinct_sync), audit_(audit)
+                            bool audit = true, bool angular_position = true)
+        : distinct_sync_(distinct_sync), audit_(audit), angular_position_(angular_position)
     {
         // One field at a time, straight from the descriptions (storage order = user order
         // until the first rebuild): set-up needs one field's copy beside the arrays.
@@ -129,7 +131,7 @@ public:
             field(v_sync_, velocity);
             field(omega_sync_, spin);
         }
-        angpos_.resize(n, zero);
+        if (angular_position_) angpos_.resize(n, zero);
         force_.resize(n, zero);
         torque_.resize(n, zero);
         field(mass_, [](const particle<Coord>& p) { return Real(sphere_mass(p.radius, p.density)); });
@@ -148,8 +150,9 @@ public:
         vec3<Real>* v_sync = distinct_sync_ ? v_sync_.data() : v_.data();
         vec3<Real>* omega_sync = distinct_sync_ ? omega_sync_.data() : omega_.data();
         auto audit = [&](buffer<Real, Policy>& b) { return audit_ ? b.data() : nullptr; };
+        vec3<Real>* angpos = angular_position_ ? angpos_.data() : nullptr;
         return {x_.size(),       x_.data(),        v_.data(),         omega_.data(),     v_sync,
-                omega_sync,      angpos_.data(),   force_.data(),     torque_.data(),    mass_.data(),
+                omega_sync,      angpos,           force_.data(),     torque_.data(),    mass_.data(),
                 audit(pressure_), audit(e_visc_), audit(e_fric_),   audit(p_visc_),    audit(p_fric_),
                 kind_.data(),    user_.data()};
     }
@@ -157,13 +160,16 @@ public:
     /// The user's index of the particle in each storage slot (host copy).
     std::vector<unsigned> user_indices() const { return user_.to_host(); }
 
-    /// Moves the particle in slot order[k] to slot k, for every k (order is a permutation),
-    /// through `scratch`: size() elements that the caller does not need (the neighbour grid's
-    /// sorted positions once the contact lists are built).
-    void permute(const unsigned* order, vec4<Coord>* scratch)
+    /// Moves the particle in slot order[k] to slot k, for every k (order is a permutation);
+    /// `sorted_x` holds the positions and radii already in that order. The forces are not
+    /// carried (the next force evaluation writes them): their array is the permutation's
+    /// scratch and holds zeros afterwards.
+    void permute(const unsigned* order, const vec4<Coord>* sorted_x)
     {
-        each_field([&](auto& field) { permute_field(field, order, scratch); });
-        permute_field(user_, order, scratch);
+        for_each_index(Policy{}, x_.size(), detail::copy_back<vec4<Coord>>{sorted_x, x_.data()});
+        each_carried_field([&](auto& field) { permute_field(field, order); });
+        permute_field(user_, order);
+        for_each_index(Policy{}, force_.size(), detail::fill_value<vec3<Real>>{force_.data(), {0, 0, 0}});
     }
 
     /// Sets which particle each slot holds (user index per slot), e.g. for a restart; the
@@ -171,11 +177,12 @@ public:
     void set_storage_order(const std::vector<unsigned>& user) { user_.assign(user); }
 
     /// Applies the permutation of the last `permute` to another per-particle array that must
-    /// stay in step with the particles (e.g. external forces).
+    /// stay in step with the particles (e.g. external forces), through the same scratch.
     template <class T>
-    void permute_along(buffer<T, Policy>& field, const unsigned* order, vec4<Coord>* scratch)
+    void permute_along(buffer<T, Policy>& field, const unsigned* order)
     {
-        permute_field(field, order, scratch);
+        permute_field(field, order);
+        for_each_index(Policy{}, force_.size(), detail::fill_value<vec3<Real>>{force_.data(), {0, 0, 0}});
     }
 
     /// A host copy of every field, in user order.
@@ -213,7 +220,7 @@ public:
             in(v_sync_, s.v_sync);
             in(omega_sync_, s.omega_sync);
         }
-        in(angpos_, s.angpos);
+        if (angular_position_) in(angpos_, s.angpos);
         in(force_, s.force);
         in(torque_, s.torque);
         in(mass_, s.mass);
@@ -238,19 +245,21 @@ private:
     template <class T> static T narrow(Coord a) { return T(a); }
     template <class T> static T narrow(std::uint8_t a) { return a; }
 
+    /// Every field that a permutation carries: all but the positions (copied from the sorted
+    /// ones) and the forces (its scratch).
     template <class F>
-    void each_field(F f)
+    void each_carried_field(F f)
     {
-        f(x_); f(v_); f(omega_); f(v_sync_); f(omega_sync_); f(angpos_); f(force_); f(torque_);
+        f(v_); f(omega_); f(v_sync_); f(omega_sync_); f(angpos_); f(torque_);
         f(mass_); f(pressure_); f(e_visc_); f(e_fric_); f(p_visc_); f(p_fric_); f(kind_);
     }
 
-    /// Gathers one field into the scratch (wide enough for any field) and copies it back.
+    /// Gathers one field into the forces' array and copies it back.
     template <class T>
-    void permute_field(buffer<T, Policy>& field, const unsigned* order, vec4<Coord>* scratch)
+    void permute_field(buffer<T, Policy>& field, const unsigned* order)
     {
-        static_assert(sizeof(T) <= sizeof(vec4<Coord>) && alignof(T) <= alignof(vec4<Coord>), "scratch too narrow");
-        T* tmp = reinterpret_cast<T*>(scratch);
+        static_assert(sizeof(T) <= sizeof(vec3<Real>) && alignof(T) <= alignof(vec3<Real>), "scratch too narrow");
+        T* tmp = reinterpret_cast<T*>(force_.data());
         const std::size_t n = field.size();
         for_each_index(Policy{}, n, detail::gather<T>{field.data(), order, tmp});
         for_each_index(Policy{}, n, detail::copy_back<T>{tmp, field.data()});
@@ -263,6 +272,7 @@ private:
     buffer<unsigned, Policy> user_;
     bool distinct_sync_ = true; ///< v_sync_, omega_sync_ hold their own values (else empty: v_, omega_)
     bool audit_ = true;         ///< the energy-audit arrays exist (else empty)
+    bool angular_position_ = true; ///< angpos_ exists (else empty)
 };
 
 } // namespace sphere
