@@ -7,8 +7,8 @@
 //                   [--tile 4 5]   (the periodic bed repeated 4 x 5 times in x and y: 1e6 particles from 50k)
 //                   [--rebuild]    (one rebuild of the contact lists after the untimed steps, for its memory)
 //
-// Memory: the resident set (VmRSS, /proc/self/status) before the simulation is built, after the
-// untimed steps, and its peak (VmHWM), per particle.
+// Memory: the resident set (VmRSS, /proc/self/status) of the program with its input file, after the
+// untimed steps, and the whole process's peak (VmHWM), per particle.
 #include <sphere/dem.cuh>
 
 #include <CLI/CLI.hpp>
@@ -139,6 +139,7 @@ int run(const options& o, const bed_file& b)
     s.energy_audit = o.audit;
     s.angular_position = false; // nor the rotation angles
 
+    const double rss_program = status_bytes("VmRSS"); // the program and the input file, before any particle
     const std::size_t per_tile = b.x.size();
     std::vector<std::size_t> order(per_tile * tx * ty);
     for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
@@ -151,7 +152,6 @@ int run(const options& o, const bed_file& b)
         ps[k].radius = Real(b.r[i]);
         ps[k].density = Real(density);
     }
-    const double rss_before = status_bytes("VmRSS");
 
     using law = contact::linear<tangential::elastic_viscous_frictional, tangential::elastic_viscous_frictional>;
     simulation<Precision, host, law, integrate::velocity_verlet> sim(s, std::move(ps)); // no second copy
@@ -175,10 +175,11 @@ int run(const options& o, const bed_file& b)
                 n, o.threads, o.precision.c_str(), o.order.c_str(), seconds, double(n) * double(o.steps) / seconds,
                 c0.pair_contacts_per_particle, c1.pair_contacts_per_particle, c0.wall_contacts, c1.wall_contacts,
                 c0.kinetic, c1.kinetic, sim.rebuilds() - rebuilds0);
-    std::printf("memory   N=%zu precision=%s  RSS before the simulation %.0f MB; after %zu steps %.0f MB: +%.0f B/particle, "
-                "peak +%.0f B/particle (set-up included), %.0f B/particle for the whole process\n",
-                n, o.precision.c_str(), rss_before / 1e6, o.pre, rss_sim / 1e6, (rss_sim - rss_before) / double(n),
-                (peak_sim - rss_before) / double(n), peak_sim / double(n));
+    std::printf("memory   N=%zu precision=%s  RSS of the program and input %.0f MB; after %zu steps %.0f MB: simulation "
+                "+%.0f B/particle; peak %.0f B/particle for the whole process (set-up, particle descriptions and "
+                "rebuilds included)\n",
+                n, o.precision.c_str(), rss_program / 1e6, o.pre, rss_sim / 1e6, (rss_sim - rss_program) / double(n),
+                peak_sim / double(n));
     return 0;
 }
 

@@ -81,13 +81,13 @@ struct particle_energy {
                 if (!(dist2 < reach * reach)) continue;
                 vec3<Real> n;
                 const Real delta_n = overlap_and_normal(d, dist2, reach, n);
-                if (delta_n < Real(0)) e.elastic += Coord(Law::pair_energy(pair_params, delta_n, c.history[k]));
+                if (delta_n < Real(0)) e.elastic += Coord(Law::pair_energy(pair_params, delta_n, c.history.load(k)));
             } else {
                 const int f = static_cast<int>(j - wall_partner_base);
                 const int a = f / 2;
                 const Real delta_n = Real((xi.xyz()[a] - Coord(walls.face[f].position)) *
                                               Coord(wall_set<Real>::inward_normal(f)[a]) - xi.w);
-                if (delta_n < Real(0)) e.elastic += Coord(Law::wall_energy(wall_params, delta_n, c.history[k]));
+                if (delta_n < Real(0)) e.elastic += Coord(Law::wall_energy(wall_params, delta_n, c.history.load(k)));
             }
         }
         if (p.e_visc) { // the energy audit is on

@@ -19,7 +19,9 @@
 /// from the partner's when the ownership changed.
 #include <algorithm>
 #include <cstddef>
+#include <cstdint>
 #include <limits>
+#include <utility>
 #include <vector>
 
 #include "../boundary/walls.cuh"
@@ -52,13 +54,75 @@ SPHERE_HDI bool has_history(const vec4<Real>& h)
     return h.x != Real(0) || h.y != Real(0) || h.z != Real(0) || h.w != Real(0);
 }
 
+/// Where the contact histories live: each entry's tangential displacement (m) and its
+/// sliding flag, in two arrays (25 B per entry in double, where one vec4 takes 32). Kernels
+/// read and write an entry as the vec4 the contact laws take: displacement in xyz, sliding
+/// flag (0 or 1) in w.
+template <class Real>
+struct history_view {
+    vec3<Real>* shift;
+    std::uint8_t* sliding;
+
+    SPHERE_HDI vec4<Real> load(std::size_t k) const
+    {
+        const vec3<Real> d = shift[k];
+        return {d.x, d.y, d.z, sliding[k] ? Real(1) : Real(0)};
+    }
+    SPHERE_HDI void store(std::size_t k, const vec4<Real>& h) const
+    {
+        shift[k] = {h.x, h.y, h.z};
+        sliding[k] = h.w != Real(0);
+    }
+};
+
+/// The owning arrays of history_view, in a policy's memory.
+template <class Real, class Policy>
+class history_store {
+public:
+    history_store() = default;
+    /// n entries without history
+    explicit history_store(std::size_t n) : shift_(n, vec3<Real>{0, 0, 0}), sliding_(n, std::uint8_t(0)) {}
+
+    std::size_t size() const { return shift_.size(); }
+    history_view<Real> view() { return {shift_.data(), sliding_.data()}; }
+    void swap(history_store& other) noexcept
+    {
+        shift_.swap(other.shift_);
+        sliding_.swap(other.sliding_);
+    }
+    /// A host copy, one vec4 per entry (xyz displacement, w sliding flag).
+    std::vector<vec4<Real>> to_host() const
+    {
+        const std::vector<vec3<Real>> d = shift_.to_host();
+        const std::vector<std::uint8_t> s = sliding_.to_host();
+        std::vector<vec4<Real>> out(d.size());
+        for (std::size_t k = 0; k < d.size(); ++k) out[k] = {d[k].x, d[k].y, d[k].z, s[k] ? Real(1) : Real(0)};
+        return out;
+    }
+    void assign(const std::vector<vec4<Real>>& h)
+    {
+        std::vector<vec3<Real>> d(h.size());
+        std::vector<std::uint8_t> s(h.size());
+        for (std::size_t k = 0; k < h.size(); ++k) {
+            d[k] = {h[k].x, h[k].y, h[k].z};
+            s[k] = h[k].w != Real(0);
+        }
+        shift_.assign(std::move(d));
+        sliding_.assign(std::move(s));
+    }
+
+private:
+    buffer<vec3<Real>, Policy> shift_;
+    buffer<std::uint8_t, Policy> sliding_;
+};
+
 /// Kernel view of the contact lists.
 template <class Real>
 struct contact_view {
     std::size_t n;                ///< particles
     const unsigned* offset;       ///< entries of rank r: [offset[r], offset[r + 1])
     const unsigned* partner;      ///< storage slot of the partner, or wall_partner_base + f (walls last)
-    vec4<Real>* history;          ///< delta_t (m) seen by the owner in xyz, sliding flag in w
+    history_view<Real> history;   ///< delta_t (m) seen by the owner in xyz, sliding flag in w
     vec4<Real>* force;            ///< f_t on the owner (N) in xyz, f_n . n (N) in w; null when not recorded
     const unsigned* slot_of_rank; ///< storage slot of each rank; null when they coincide (settings.reorder)
     const unsigned* rank_of_slot; ///< the inverse; null when they coincide
@@ -217,7 +281,7 @@ template <class Real>
 struct old_lists {
     const unsigned* offset;
     const unsigned* partner;
-    const vec4<Real>* history;
+    history_view<Real> history;
     const unsigned* rank_of_slot; ///< null when old ranks and slots coincide
 
     /// The history of the entry of old slot `owner` for `code` (an old slot or a wall code);
@@ -227,7 +291,7 @@ struct old_lists {
         const unsigned r = rank_of_slot ? rank_of_slot[owner] : owner;
         for (unsigned m = offset[r]; m < offset[r + 1]; ++m)
             if (partner[m] == code) {
-                h = history[m];
+                h = history.load(m);
                 return true;
             }
         return false;
@@ -242,7 +306,7 @@ struct fill_entries {
     neighbour_scan<Coord> scan;
     const unsigned* offset;
     unsigned* partner;
-    vec4<Real>* history;
+    history_view<Real> history;
     old_lists<Real> old;
     bool keep_order;
 
@@ -272,7 +336,7 @@ struct fill_entries {
                 if (!old.find(me, them, h) && old.find(them, me, h)) h = mirrored(h);
                 p[a] = keep_order ? them : code;
             }
-            history[begin + a] = h;
+            history.store(begin + a, h);
         }
     }
 };
@@ -281,12 +345,12 @@ struct fill_entries {
 template <class Real>
 struct count_histories {
     const unsigned* offset;
-    const vec4<Real>* history;
+    history_view<Real> history;
     unsigned* count;
     SPHERE_HD void operator()(std::size_t r) const
     {
         unsigned c = 0;
-        for (unsigned e = offset[r]; e < offset[r + 1]; ++e) c += has_history(history[e]);
+        for (unsigned e = offset[r]; e < offset[r + 1]; ++e) c += has_history(history.load(e));
         count[r] = c;
     }
 };
@@ -296,17 +360,18 @@ template <class Real>
 struct copy_histories {
     const unsigned* offset;
     const unsigned* partner;
-    const vec4<Real>* history;
+    history_view<Real> history;
     const unsigned* to_offset;
     unsigned* to_partner;
-    vec4<Real>* to_history;
+    history_view<Real> to_history;
     SPHERE_HD void operator()(std::size_t r) const
     {
         unsigned k = to_offset[r];
         for (unsigned e = offset[r]; e < offset[r + 1]; ++e) {
-            if (has_history(history[e])) {
+            const vec4<Real> h = history.load(e);
+            if (has_history(h)) {
                 to_partner[k] = partner[e];
-                to_history[k] = history[e];
+                to_history.store(k, h);
                 ++k;
             }
         }
@@ -386,11 +451,11 @@ public:
         if (total >= std::size_t(std::numeric_limits<unsigned>::max()))
             detail::fail("contact lists: ", total, " entries within r_i + r_j + skin, more than 2^32 - 1; reduce the skin");
         buffer<unsigned, Policy> partner(total);
-        buffer<vec4<Real>, Policy> history(total);
-        const detail::old_lists<Real> old{offset_.data(), partner_.data(), history_.data(),
+        history_store<Real, Policy> history(total);
+        const detail::old_lists<Real> old{offset_.data(), partner_.data(), history_.view(),
                                           keep_order_ ? rank_of_slot_.data() : nullptr};
         for_each_index(Policy{}, n,
-                       detail::fill_entries<Coord, Real>{scan, offset.data(), partner.data(), history.data(), old,
+                       detail::fill_entries<Coord, Real>{scan, offset.data(), partner.data(), history.view(), old,
                                                          keep_order});
         offset_.swap(offset);
         partner_.swap(partner);
@@ -414,7 +479,7 @@ public:
         return {size(),
                 offset_.data(),
                 partner_.data(),
-                history_.data(),
+                history_.view(),
                 record_forces_ ? force_.data() : nullptr,
                 keep_order_ ? slot_of_rank_.data() : nullptr,
                 keep_order_ ? rank_of_slot_.data() : nullptr};
@@ -550,13 +615,13 @@ private:
         const std::size_t n = size();
         if (entries_ == 0) return;
         buffer<unsigned, Policy> offset(n + 1, 0u);
-        for_each_index(Policy{}, n, detail::count_histories<Real>{offset_.data(), history_.data(), offset.data()});
+        for_each_index(Policy{}, n, detail::count_histories<Real>{offset_.data(), history_.view(), offset.data()});
         const std::size_t kept = exclusive_scan_in_place(Policy{}, offset.data(), n + 1);
         buffer<unsigned, Policy> partner(kept);
-        buffer<vec4<Real>, Policy> history(kept);
+        history_store<Real, Policy> history(kept);
         for_each_index(Policy{}, n,
-                       detail::copy_histories<Real>{offset_.data(), partner_.data(), history_.data(), offset.data(),
-                                                    partner.data(), history.data()});
+                       detail::copy_histories<Real>{offset_.data(), partner_.data(), history_.view(), offset.data(),
+                                                    partner.data(), history.view()});
         offset_.swap(offset);
         partner_.swap(partner);
         history_.swap(history);
@@ -604,7 +669,8 @@ private:
     bool periodic_layers_ = false;
     std::size_t entries_ = 0;
     buffer<unsigned, Policy> offset_, partner_;
-    buffer<vec4<Real>, Policy> history_, force_;
+    history_store<Real, Policy> history_;
+    buffer<vec4<Real>, Policy> force_;
     buffer<unsigned, Policy> slot_of_rank_, rank_of_slot_; ///< only with keep_order
     buffer<unsigned, Policy> wall_ranks_;
     std::size_t wall_particles_ = 0;

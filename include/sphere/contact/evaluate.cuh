@@ -177,7 +177,7 @@ struct wall_contacts {
             vec3<Real> n = wall_set<Real>::inward_normal(f);
             const Coord dist_c = (xi.xyz()[a] - Coord(wall.position)) * Coord(n[a]);
             const Real dist = Real(dist_c), delta_n = Real(dist_c - xi.w);
-            vec4<Real> h = c.history[k];
+            vec4<Real> h = c.history.load(k);
             if (delta_n < Real(0)) {
                 contact_motion<Real> m{n, delta_n, vi + dist * cross(n, wi), si + dist * cross(n, ti), p.mass[i]};
                 m.velocity[a] -= Real(wall.velocity);
@@ -197,7 +197,7 @@ struct wall_contacts {
                 h = vec4<Real>{0, 0, 0, 0}; // a contact that has ended forgets its history
                 if (Record) c.force[k] = vec4<Real>{0, 0, 0, 0};
             }
-            if (update_history) c.history[k] = h;
+            if (update_history) c.history.store(k, h);
         }
         p.force[i] = force;
         p.torque[i] = torque;

@@ -82,6 +82,9 @@ struct slab_pairs {
                 t.owner[t.count] = i;
                 t.partner[t.count] = j;
                 t.entry[t.count] = e;
+                // the sliding flag goes into the tile here: the SIMD loop gathers the
+                // displacements, but cannot gather bytes
+                t.hw[t.count] = c.history.sliding[e] ? Real(1) : Real(0);
                 if constexpr (touching_lanes_only) {
                     // Only touching pairs take a lane; the others only forget their history.
                     // Both lists grow without a branch on the outcome, which no predictor
@@ -117,7 +120,7 @@ private:
     void forget(const unsigned* entry, int& count) const
     {
         for (int k = 0; k < count; ++k) {
-            if (update_history) c.history[entry[k]] = vec4<Real>{0, 0, 0, 0};
+            if (update_history) c.history.store(entry[k], vec4<Real>{0, 0, 0, 0});
             if (Record) c.force[entry[k]] = vec4<Real>{0, 0, 0, 0};
         }
         count = 0;
@@ -130,13 +133,15 @@ private:
             t.owner[k] = t.owner[0];
             t.partner[k] = t.partner[0];
             t.entry[k] = t.entry[0];
+            t.hw[k] = t.hw[0];
         }
         // Local copies: loop invariants the compiler can keep in registers.
         pair_contact<P, Law, OneVelocity> pairs = eval;
-        const vec4<Real>* history = c.history;
+        const vec3<Real>* shift = c.history.shift;
         SPHERE_VECTORISE_LOOP
         for (int k = 0; k < w; ++k) {
-            vec4<Real> h = history[t.entry[k]];
+            const vec3<Real> d = shift[t.entry[k]];
+            vec4<Real> h{d.x, d.y, d.z, t.hw[k]};
             pair_result<Real> r = pairs.template evaluate<true>(t.owner[k], t.partner[k], h);
             t.fx[k] = r.force.x;
             t.fy[k] = r.force.y;
@@ -166,7 +171,7 @@ private:
         const particle_view<P>& p = eval.p;
         for (int k = 0; k < t.count; ++k) {
             const unsigned i = t.owner[k], j = t.partner[k], e = t.entry[k];
-            if (update_history) c.history[e] = {t.hx[k], t.hy[k], t.hz[k], t.hw[k]};
+            if (update_history) c.history.store(e, {t.hx[k], t.hy[k], t.hz[k], t.hw[k]});
             if (Record) c.force[e] = {t.rx[k], t.ry[k], t.rz[k], t.rw[k]};
             const vec3<Real> f{t.fx[k], t.fy[k], t.fz[k]};
             p.force[i] += f;
@@ -311,9 +316,9 @@ struct evaluate_owned_pairs {
         for (unsigned e = c.offset[r]; e < end; ++e) {
             const unsigned j = c.partner[e];
             if (j >= wall_partner_base) break;
-            vec4<Real> h = c.history[e];
+            vec4<Real> h = c.history.load(e);
             pair_result<Real> res = eval.template evaluate<false>(i, j, h);
-            if (update_history) c.history[e] = h;
+            if (update_history) c.history.store(e, h);
             if (Record) c.force[e] = res.record;
             force[e] = res.force;
             torque_i[e] = res.torque_i;
