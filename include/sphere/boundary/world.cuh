@@ -52,13 +52,20 @@ struct world {
     }
 
     /// Maps a coordinate on a periodic axis into [lo, hi), however many periods away it is;
-    /// unchanged on wall axes.
-    SPHERE_HD Real wrap(Real c, int a) const
+    /// unchanged on wall axes and when not finite. Written with selects only, so that it
+    /// vectorises in a loop over particles.
+    SPHERE_HDI Real wrap(Real c, int a) const
     {
-        if (!periodic(a) || !std::isfinite(c) || (c >= lo[a] && c < hi[a])) return c;
-        c -= length(a) * std::floor((c - lo[a]) / length(a));
-        return c >= lo[a] && c < hi[a] ? c : lo[a]; // round-off can land on hi or a hair below lo
+        const Real l = length(a);
+        const bool inside = c >= lo[a] && c < hi[a];
+        const Real shifted = c - l * std::floor((c - lo[a]) / l);
+        // round-off can land on hi or a hair below lo
+        const Real back = shifted >= lo[a] && shifted < hi[a] ? shifted : lo[a];
+        return periodic(a) && std::isfinite(c) && !inside ? back : c;
     }
+
+    /// A position with wrap applied on every axis.
+    SPHERE_HDI vec3<Real> wrap(const vec3<Real>& x) const { return {wrap(x.x, 0), wrap(x.y, 1), wrap(x.z, 2)}; }
 };
 
 } // namespace sphere

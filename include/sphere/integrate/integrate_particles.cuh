@@ -41,22 +41,6 @@ SPHERE_HDI void accelerations(const particle_view<P>& p, std::size_t i, motion k
     alpha = p.torque[i] * (free ? Real(1) / (Real(0.4) * m * r * r) : Real(0));
 }
 
-/// A position wrapped into the box on its periodic axes (world::wrap, without branches).
-template <class Coord>
-SPHERE_HDI vec3<Coord> wrapped(const world<Coord>& box, const vec3<Coord>& x)
-{
-    vec3<Coord> out;
-    for (int a = 0; a < 3; ++a) {
-        const Coord c = x[a], lo = box.lo[a], hi = box.hi[a], l = hi - lo;
-        const bool inside = c >= lo && c < hi;
-        const Coord shifted = c - l * std::floor((c - lo) / l);
-        // round-off can land on hi or a hair below lo
-        const Coord back = shifted >= lo && shifted < hi ? shifted : lo;
-        out[a] = box.periodic(a) && std::isfinite(c) && !inside ? back : c;
-    }
-    return out;
-}
-
 /// Advances particle i by dt after the forces: free particles with the integrator policy,
 /// prescribed ones at their own velocities, horizontally prescribed ones at their own x, y and
 /// angular velocities and along z under the contact force alone, fixed ones not at all. Also
@@ -90,7 +74,7 @@ struct integrate_particles {
         Integrator::advance(pos, v, a, dt);
         Integrator::advance(angle, w, alpha, dt);
         if (!drifted) {
-            pos = wrapped(box, pos);
+            pos = box.wrap(pos);
             p.x[i] = {pos.x, pos.y, pos.z, x.w};
         }
         p.v[i] = v;
@@ -127,7 +111,7 @@ struct drift_particles {
         accelerations<External>(p, i, kind, gravity, external, a, alpha);
         Integrator::drift(pos, v, a, dt);
         Integrator::drift(angle, w, alpha, dt);
-        pos = wrapped(box, pos);
+        pos = box.wrap(pos);
         p.x[i] = {pos.x, pos.y, pos.z, x.w};
         p.v[i] = v;
         p.omega[i] = w;
