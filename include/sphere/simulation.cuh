@@ -493,11 +493,10 @@ private:
         lists_.rebuild(g, walls_, settings_.skin, !settings_.reorder);
         interaction_.lists_changed();
         if (settings_.reorder) {
-            particles_.permute(g.order, x_at_build_.data());
-            if (external_.size()) particles_.permute_along(external_, g.order);
+            particles_.permute(g.order, x_at_build_.data(), external_);
         } else {
             const particle_view<Precision> p = particles_.view();
-            for_each_index(Policy{}, p.n, detail::copy_positions<Coord>{p.x, x_at_build_.data()});
+            for_each_index(Policy{}, p.n, detail::copy_back<vec4<Coord>>{p.x, x_at_build_.data()});
         }
         walls_at_build_ = walls_;
         ++rebuilds_;

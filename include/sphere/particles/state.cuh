@@ -48,15 +48,6 @@ struct particle_view {
 };
 
 namespace detail {
-/// Copies particle i's position and radius (kernel body): positions at a reference time, for
-/// displacements since then.
-template <class Coord>
-struct copy_positions {
-    const vec4<Coord>* from;
-    vec4<Coord>* to;
-    SPHERE_HD void operator()(std::size_t i) const { to[i] = from[i]; }
-};
-
 /// to[k] = from[order[k]] (kernel body of a permutation).
 template <class T>
 struct gather {
@@ -66,6 +57,7 @@ struct gather {
     SPHERE_HD void operator()(std::size_t k) const { to[k] = from[order[k]]; }
 };
 
+/// to[k] = from[k] (kernel body of a copy).
 template <class T>
 struct copy_back {
     const T* from;
@@ -160,30 +152,24 @@ public:
     /// The user's index of the particle in each storage slot (host copy).
     std::vector<unsigned> user_indices() const { return user_.to_host(); }
 
-    /// Moves the particle in slot order[k] to slot k, for every k (order is a permutation);
-    /// `sorted_x` holds the positions and radii already in that order. The forces are not
-    /// carried (the next force evaluation writes them): their array is the permutation's
-    /// scratch and holds zeros afterwards.
-    void permute(const unsigned* order, const vec4<Coord>* sorted_x)
+    /// Moves the particle in slot order[k] to slot k, for every k (order is a permutation),
+    /// and with it every array in `along` that must stay in step with the particles (e.g.
+    /// external forces; an empty one stays empty); `sorted_x` holds the positions and radii
+    /// already in that order. The forces are not carried (the next force evaluation writes
+    /// them): their array is the permutation's scratch and holds zeros afterwards.
+    template <class... Along>
+    void permute(const unsigned* order, const vec4<Coord>* sorted_x, Along&... along)
     {
         for_each_index(Policy{}, x_.size(), detail::copy_back<vec4<Coord>>{sorted_x, x_.data()});
         each_carried_field([&](auto& field) { permute_field(field, order); });
         permute_field(user_, order);
+        (permute_field(along, order), ...);
         for_each_index(Policy{}, force_.size(), detail::fill_value<vec3<Real>>{force_.data(), {0, 0, 0}});
     }
 
     /// Sets which particle each slot holds (user index per slot), e.g. for a restart; the
     /// fields' contents must be restored afterwards.
     void set_storage_order(const std::vector<unsigned>& user) { user_.assign(user); }
-
-    /// Applies the permutation of the last `permute` to another per-particle array that must
-    /// stay in step with the particles (e.g. external forces), through the same scratch.
-    template <class T>
-    void permute_along(buffer<T, Policy>& field, const unsigned* order)
-    {
-        permute_field(field, order);
-        for_each_index(Policy{}, force_.size(), detail::fill_value<vec3<Real>>{force_.data(), {0, 0, 0}});
-    }
 
     /// A host copy of every field, in user order.
     particle_snapshot<Coord> snapshot() const
