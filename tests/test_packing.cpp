@@ -1,4 +1,4 @@
-// Sample preparation (include/sphere/particles/distributions.cuh and packing.cuh):
+// Sample preparation (include/sphere/particles/distributions.cuh and setup/packing.cuh):
 // - radii: the same seed gives the same radii (checked against values computed by an
 //   independent implementation of MT19937-64 and the documented transforms), in range, with
 //   the analytic moments within a few standard errors of the sample size;

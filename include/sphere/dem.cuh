@@ -2,7 +2,6 @@
 /// \file
 /// The DEM half of sphere: `#include <sphere/dem.cuh>` brings in particles, the neighbour
 /// grid, contact laws, walls, integrators, the simulation template and its diagnostics.
-#include "analysis/energy.cuh"
 #include "analysis/porosity.cuh"
 #include "analysis/shear.cuh"
 #include "analysis/stress.cuh"
@@ -10,6 +9,7 @@
 #include "boundary/walls.cuh"
 #include "boundary/world.cuh"
 #include "contact/contact_lists.cuh"
+#include "contact/energy.cuh"
 #include "contact/interact.cuh"
 #include "contact/linear.cuh"
 #include "contact/params.cuh"
@@ -31,10 +31,10 @@
 #include "integrate/integrators.cuh"
 #include "integrate/time_step.cuh"
 #include "particles/distributions.cuh"
-#include "particles/layers.cuh"
-#include "particles/packing.cuh"
 #include "particles/particle.cuh"
 #include "particles/state.cuh"
 #include "particles/validate.cuh"
 #include "settings.cuh"
+#include "setup/layers.cuh"
+#include "setup/packing.cuh"
 #include "simulation.cuh"

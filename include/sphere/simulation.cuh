@@ -10,10 +10,10 @@
 #include <utility>
 #include <vector>
 
-#include "analysis/energy.cuh"
 #include "boundary/wall_control.cuh"
 #include "boundary/walls.cuh"
 #include "contact/contact_lists.cuh"
+#include "contact/energy.cuh"
 #include "contact/evaluate.cuh"
 #include "contact/interact.cuh"
 #include "contact/linear.cuh"
@@ -566,7 +566,7 @@ private:
     {
         constexpr bool check_here = !Integrator::drifts_before_forces;
         const auto walls = wall_contacts<Book, Record>(true);
-        if constexpr (std::is_same_v<Policy, host>) {
+        if constexpr (runs_in_blocks<Policy>) {
             const std::size_t count = lists_.wall_particles();
             wall_loads_.assign(count, detail::wall_loads{{0, 0, 0, 0, 0, 0}});
             std::vector<Coord> moved(std::size_t(host_threads()), Coord(0));

@@ -395,9 +395,9 @@ public:
     /// The schedule `how` resolves to on this backend; throws for slabs on CUDA.
     static pair_summation resolve(pair_summation how)
     {
-        constexpr bool on_host = std::is_same_v<Policy, host>;
-        if (how == pair_summation::automatic) return on_host ? pair_summation::slabs : pair_summation::gather;
-        if (how == pair_summation::slabs && !on_host)
+        constexpr bool blocks = runs_in_blocks<Policy>;
+        if (how == pair_summation::automatic) return blocks ? pair_summation::slabs : pair_summation::gather;
+        if (how == pair_summation::slabs && !blocks)
             detail::fail("settings.pair_summation = slabs needs the host backend; use gather (or automatic) on CUDA");
         if (how != pair_summation::slabs && how != pair_summation::gather)
             detail::fail("settings.pair_summation = ", unsigned(how), ": not a pair_summation");
@@ -419,7 +419,7 @@ public:
         const particle_view<P>& p = eval.p;
         const contact_view<Real> c = lists.view();
         if (resolve(how) == pair_summation::slabs) {
-            if constexpr (std::is_same_v<Policy, host>) {
+            if constexpr (runs_in_blocks<Policy>) {
                 const detail::slab_phases phases(lists.layer_entries(), lists.periodic_layers());
                 detail::sum_by_slabs(detail::slab_pairs<P, Law, Book, Record, OneVelocity>{eval, c, update_history},
                                      detail::zero_pair_sums<P, Book>{p}, finish, p.n, lists.layer_start(), phases);

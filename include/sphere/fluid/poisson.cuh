@@ -75,7 +75,6 @@
 /// same backend gives bit-identical output (on the host, for any number of threads).
 #include <cmath>
 #include <cstddef>
-#include <type_traits>
 #include <vector>
 
 #include "../core/config.cuh"
@@ -573,7 +572,7 @@ public:
     void fill_ghosts(Real* e) const
     {
         const std::size_t count = grid_.field_size() - grid_.cell_count();
-        const std::size_t per_index = std::is_same<Policy, host>::value ? host_cells_per_index : 1;
+        const std::size_t per_index = runs_in_blocks<Policy> ? host_cells_per_index : 1;
         for_each_index(Policy{}, (count + per_index - 1) / per_index,
                        fill_poisson_ghosts<Real>{s_, e, per_index, count});
     }

@@ -17,9 +17,9 @@
 #include "../core/error.cuh"
 #include "../core/vec.cuh"
 #include "../grid/geometry.cuh"
+#include "../particles/distributions.cuh"
+#include "../particles/particle.cuh"
 #include "../settings.cuh"
-#include "distributions.cuh"
-#include "particle.cuh"
 
 namespace sphere {
 

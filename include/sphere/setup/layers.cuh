@@ -15,8 +15,8 @@
 #include "../analysis/shear.cuh"
 #include "../core/error.cuh"
 #include "../core/vec.cuh"
-#include "particle.cuh"
-#include "state.cuh"
+#include "../particles/particle.cuh"
+#include "../particles/state.cuh"
 
 namespace sphere {
 

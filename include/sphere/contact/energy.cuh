@@ -6,10 +6,10 @@
 
 #include "../boundary/walls.cuh"
 #include "../boundary/world.cuh"
-#include "../contact/contact_lists.cuh"
-#include "../contact/evaluate.cuh"
-#include "../contact/params.cuh"
 #include "../particles/state.cuh"
+#include "contact_lists.cuh"
+#include "evaluate.cuh"
+#include "params.cuh"
 
 namespace sphere {
 
