@@ -19,6 +19,7 @@
 #include "contact/linear.cuh"
 #include "core/error.cuh"
 #include "exec/algorithms.cuh"
+#include "exec/context.cuh"
 #include "exec/for_each.cuh"
 #include "exec/thread_governor.cuh"
 #include "grid/neighbor_grid.cuh"
@@ -103,6 +104,17 @@ struct finish_block {
         }
         if (Check) moved[thread] = most;
     }
+};
+
+/// What the host reads back at the end of a step, in one copy (docs/architecture.md,
+/// *Execution context*): the particles' loads on the walls (N), the particle check's largest
+/// squared displacement since the last rebuild (m^2, +infinity when a particle failed it) and
+/// the power of whatever drives the prescribed particles (W).
+template <class Coord>
+struct step_report {
+    wall_loads loads;
+    Coord moved2;
+    double drive_power;
 };
 
 /// Runs two particle kernels on particle i, one after the other.
@@ -236,6 +248,7 @@ public:
         lists_ = contact_lists<Precision, Policy>(n, s.contact_forces);
         summation_ = interaction<Precision, Policy>::resolve(s.pair_summation);
         x_at_build_.resize(n);
+        report_.resize(1);
         rebuild_lists();
         // An integrator that kicks before the forces needs the forces of the start.
         if (Integrator::drifts_before_forces)
@@ -527,62 +540,70 @@ private:
         constexpr bool drifted = Integrator::drifts_before_forces;
         const detail::integrate_particles<Precision, Integrator, External> integrate{p, settings_.box, gravity_,
                                                                                    Real(dt_), external};
+        detail::step_report<Coord>* report = report_.data(); // policy memory
         if constexpr (drifted) {
-            judge(checked(detail::drift_particles<Precision, Integrator, External>{p, settings_.box, gravity_, Real(dt_),
-                                                                                  external}),
-                  steps_ + 1);
+            checked_into(detail::drift_particles<Precision, Integrator, External>{p, settings_.box, gravity_, Real(dt_),
+                                                                                 external},
+                         &report->moved2);
+            Coord moved2 = 0;
+            context_.read_back(&moved2, &report->moved2, 1, "the particle check after the drift", steps_ + 1);
+            judge(moved2, steps_ + 1);
             turn();
         }
         if (needs_rebuild_) rebuild_lists();
-        detail::wall_loads loads{{0, 0, 0, 0, 0, 0}};
-        Coord moved2 = 0;
         if constexpr (Book) {
             const detail::both<detail::finish_audit<Precision>, decltype(integrate)> body{{p, Real(dt_)}, integrate};
-            finish_step<Book, Record>(body, loads, moved2);
+            finish_step<Book, Record>(body, report);
         } else {
-            finish_step<Book, Record>(integrate, loads, moved2);
+            finish_step<Book, Record>(integrate, report);
         }
         if constexpr (!drifted) turn();
-        advance_walls(walls_, settings_.walls, settings_.box, loads.force, time_, dt_, steps_ + 1);
         if (drive_)
-            drive_work_ += transform_reduce(Policy{}, n,
-                                            detail::by_rank<detail::drive_power<Precision>, Real>{{p, gravity_},
-                                                                                               lists_.view()},
-                                            0.0, plus_op{}) *
-                           double(dt_);
+            transform_reduce_into(context_, n,
+                                  detail::by_rank<detail::drive_power<Precision>, Real>{{p, gravity_}, lists_.view()},
+                                  0.0, plus_op{}, &report->drive_power);
+        detail::step_report<Coord> done{};
+        context_.read_back(&done, report, 1, "the step's report (wall loads, particle check, drive power)",
+                           steps_ + 1);
+        advance_walls(walls_, settings_.walls, settings_.box, done.loads.force, time_, dt_, steps_ + 1);
+        if (drive_) drive_work_ += done.drive_power * double(dt_);
         ++steps_;
         time_ = static_cast<double>(steps_) * static_cast<double>(dt_);
-        if constexpr (!drifted) judge(moved2, steps_);
+        if constexpr (!drifted) judge(done.moved2, steps_);
         for (const auto& o : observers_)
             if (steps_ % o.first == 0) o.second(*this);
     }
 
     /// The pair sums, the walls and `body` (the integration after the forces), with the
     /// particle check when the integrator moves the particles after the forces: in one parallel
-    /// region on the host's slab schedule, else pass after pass. Returns the wall loads and
-    /// the largest squared displacement of the check.
+    /// region on the host's slab schedule, else pass after pass. Leaves the wall loads and the
+    /// check's largest squared displacement in `report` (policy memory).
     template <bool Book, bool Record, class Body>
-    void finish_step(const Body& body, detail::wall_loads& loads, Coord& moved2)
+    void finish_step(const Body& body, detail::step_report<Coord>* report)
     {
         constexpr bool check_here = !Integrator::drifts_before_forces;
         const auto walls = wall_contacts<Book, Record>(true);
-        if constexpr (runs_in_blocks<Policy>) {
+        if constexpr (runs_in_blocks<Policy>) { // report is host memory
             const std::size_t count = lists_.wall_particles();
             wall_loads_.assign(count, detail::wall_loads{{0, 0, 0, 0, 0, 0}});
             std::vector<Coord> moved(std::size_t(host_threads()), Coord(0));
             const detail::finish_block<Precision, decltype(walls), Body, check_here> finish{
                 walls, body, check(), lists_.view(), lists_.wall_ranks(), count, wall_loads_.data(), moved.data()};
             if (interaction_.template sum_pairs<Book, Record>(pair_contact(), lists_, summation_, true, finish)) {
-                for (const detail::wall_loads& l : wall_loads_) loads = loads + l;
-                for (Coord m : moved) moved2 = max_op{}(moved2, m);
+                report->loads = detail::wall_loads{{0, 0, 0, 0, 0, 0}};
+                for (const detail::wall_loads& l : wall_loads_) report->loads = report->loads + l;
+                if constexpr (check_here) {
+                    report->moved2 = 0;
+                    for (Coord m : moved) report->moved2 = max_op{}(report->moved2, m);
+                }
                 return;
             }
         } else {
             interaction_.template sum_pairs<Book, Record>(pair_contact(), lists_, summation_, true);
         }
-        loads = transform_reduce(Policy{}, lists_.wall_particles(), walls, detail::wall_loads{{0, 0, 0, 0, 0, 0}},
-                                 plus_op{});
-        if constexpr (check_here) moved2 = checked(body);
+        transform_reduce_into(context_, lists_.wall_particles(), walls, detail::wall_loads{{0, 0, 0, 0, 0, 0}},
+                              plus_op{}, &report->loads);
+        if constexpr (check_here) checked_into(body, &report->moved2);
         else for_each_index(Policy{}, particles_.size(), body);
     }
 
@@ -600,8 +621,8 @@ private:
     void initial_forces()
     {
         interaction_.template sum_pairs<false, Record>(pair_contact(), lists_, summation_, false);
-        transform_reduce(Policy{}, lists_.wall_particles(), wall_contacts<false, Record>(false),
-                         detail::wall_loads{{0, 0, 0, 0, 0, 0}}, plus_op{});
+        transform_reduce_into(context_, lists_.wall_particles(), wall_contacts<false, Record>(false),
+                              detail::wall_loads{{0, 0, 0, 0, 0, 0}}, plus_op{}, &report_.data()->loads);
     }
 
     detail::pair_contact<Precision, Law, Integrator::drifts_before_forces> pair_contact()
@@ -619,13 +640,14 @@ private:
 
     /// Runs the particle kernel `body` on every particle and checks each one after it, in one
     /// pass (a particle outside the walls, non-finite values, the largest displacement since
-    /// the lists were built); returns the largest squared displacement, +infinity when a
-    /// particle failed the check.
+    /// the lists were built); leaves the largest squared displacement, +infinity when a
+    /// particle failed the check, in `moved2` (policy memory).
     template <class Body>
-    Coord checked(const Body& body)
+    void checked_into(const Body& body, Coord* moved2)
     {
         const particle_view<Precision> p = particles_.view();
-        return transform_reduce(Policy{}, p.n, detail::then_check<Body, Precision>{body, check()}, Coord(0), max_op{});
+        transform_reduce_into(context_, p.n, detail::then_check<Body, Precision>{body, check()}, Coord(0), max_op{},
+                              moved2);
     }
 
     detail::check_particle<Precision> check()
@@ -711,6 +733,8 @@ private:
     interaction<Precision, Policy> interaction_;
     pair_summation summation_ = pair_summation::slabs; ///< settings_.pair_summation, resolved for the backend
     buffer<vec4<Coord>, Policy> x_at_build_;
+    execution_context<Policy> context_;
+    buffer<detail::step_report<Coord>, Policy> report_; ///< one, written by the step's reductions
     wall_set<Coord> walls_at_build_;      ///< the walls when the lists were built
     bool drive_ = false;                  ///< some particle is prescribed: book the drive's work
     buffer<vec3<Real>, Policy> external_; ///< external forces (empty until external_forces() is called)

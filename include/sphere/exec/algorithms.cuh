@@ -6,6 +6,10 @@
 ///
 /// Host reductions sum fixed chunks of host_chunk indices and then the chunk results in order,
 /// so a floating-point sum is bit-identical for any number of OpenMP threads.
+///
+/// Each of these allocates temporary storage on CUDA, and those that return a value to the
+/// host read it back: both count in device_activity() on every backend. The step's own
+/// reductions go through an execution_context instead (exec/context.cuh), which does neither.
 #include <cstddef>
 #include <type_traits>
 #include <vector>
@@ -15,6 +19,8 @@
 #include <thrust/system/omp/execution_policy.h>
 
 #include "../core/config.cuh"
+#include "activity.cuh"
+#include "cuda_error.cuh"
 #include "for_each.cuh"
 #include "host_team.cuh"
 #include "policy.cuh"
@@ -48,6 +54,7 @@ struct min_op {
 template <class Key, class Value>
 void sort_by_key(host, Key* keys, Value* values, std::size_t n)
 {
+    ++device_activity().allocations;
     if (n >= host_parallel_threshold && host_team() > 1)
         thrust::stable_sort_by_key(thrust::omp::par, keys, keys + n, values);
     else thrust::stable_sort_by_key(thrust::cpp::par, keys, keys + n, values);
@@ -57,6 +64,8 @@ void sort_by_key(host, Key* keys, Value* values, std::size_t n)
 /// total of the original values. For the offsets of compressed rows.
 inline std::size_t exclusive_scan_in_place(host, unsigned* values, std::size_t n)
 {
+    ++device_activity().allocations;
+    device_activity().read_backs += 2; // the last value before and after the scan
     std::size_t sum = 0;
     for (std::size_t i = 0; i < n; ++i) {
         const unsigned v = values[i];
@@ -70,19 +79,23 @@ inline std::size_t exclusive_scan_in_place(host, unsigned* values, std::size_t n
 /// calling thread: a store per value, cheaper than a parallel scan at the sizes it serves.
 inline void suffix_min_in_place(host, unsigned* values, std::size_t n)
 {
+    ++device_activity().allocations;
     for (std::size_t i = n; i-- > 1;)
         if (values[i] < values[i - 1]) values[i - 1] = values[i];
 }
 
-/// Returns init op f(0) op f(1) ... op f(n-1), in a fixed association order: in order within
-/// chunks of host_chunk indices (small enough to share n = 1e4 evenly between threads), then
-/// the chunks in order. For a number type T the values of a chunk are computed first, in a
-/// loop that may vectorise, and then combined in order.
+namespace detail {
+/// Number of partial results of a host reduction over n indices.
+inline std::size_t host_reduce_chunks(std::size_t n) { return (n + host_chunk - 1) / host_chunk; }
+
+/// init op f(0) op f(1) ... op f(n-1), in a fixed association order: in order within chunks of
+/// host_chunk indices (small enough to share n = 1e4 evenly between threads), then the chunks
+/// in order; `partial` holds host_reduce_chunks(n) values. For a number type T the values of a
+/// chunk are computed first, in a loop that may vectorise, and then combined in order.
 template <class T, class Transform, class Op>
-T transform_reduce(host, std::size_t n, const Transform& f, T init, Op op)
+T host_reduce(std::size_t n, const Transform& f, T init, Op op, T* partial)
 {
-    const std::size_t chunks = (n + host_chunk - 1) / host_chunk;
-    std::vector<T> partial(chunks, init);
+    const std::size_t chunks = host_reduce_chunks(n);
     const long long count = static_cast<long long>(chunks);
 #pragma omp parallel for schedule(static) if (chunks > 1) num_threads(host_team())
     for (long long c = 0; c < count; ++c) {
@@ -101,40 +114,63 @@ T transform_reduce(host, std::size_t n, const Transform& f, T init, Op op)
         partial[static_cast<std::size_t>(c)] = acc;
     }
     T result = init;
-    for (const T& p : partial) result = op(result, p);
+    for (std::size_t c = 0; c < chunks; ++c) result = op(result, partial[c]);
     return result;
+}
+} // namespace detail
+
+/// Returns init op f(0) op f(1) ... op f(n-1) to the host, in the fixed association order of
+/// detail::host_reduce (bit-identical for any number of threads).
+template <class T, class Transform, class Op>
+T transform_reduce(host, std::size_t n, const Transform& f, T init, Op op)
+{
+    ++device_activity().allocations;
+    ++device_activity().read_backs;
+    std::vector<T> partial(detail::host_reduce_chunks(n), init);
+    return detail::host_reduce(n, f, init, op, partial.data());
 }
 
 #if SPHERE_CUDA_COMPILER
 template <class Key, class Value>
 void sort_by_key(cuda, Key* keys, Value* values, std::size_t n)
 {
-    thrust::stable_sort_by_key(thrust::device, keys, keys + n, values);
+    ++device_activity().allocations;
+    detail::guarded("thrust::stable_sort_by_key", [&] { thrust::stable_sort_by_key(thrust::device, keys, keys + n, values); });
 }
 
 inline std::size_t exclusive_scan_in_place(cuda, unsigned* values, std::size_t n)
 {
+    ++device_activity().allocations;
+    device_activity().read_backs += 2;
     if (n == 0) return 0;
     unsigned last = 0;
-    cudaMemcpy(&last, values + n - 1, sizeof last, cudaMemcpyDeviceToHost);
-    thrust::exclusive_scan(thrust::device, values, values + n, values);
+    detail::check_cuda(cudaMemcpy(&last, values + n - 1, sizeof last, cudaMemcpyDeviceToHost),
+                       "cudaMemcpy (the last value before the scan)");
+    detail::guarded("thrust::exclusive_scan", [&] { thrust::exclusive_scan(thrust::device, values, values + n, values); });
     unsigned before_last = 0;
-    cudaMemcpy(&before_last, values + n - 1, sizeof before_last, cudaMemcpyDeviceToHost);
+    detail::check_cuda(cudaMemcpy(&before_last, values + n - 1, sizeof before_last, cudaMemcpyDeviceToHost),
+                       "cudaMemcpy (the last value after the scan)");
     return std::size_t(before_last) + last;
 }
 
 inline void suffix_min_in_place(cuda, unsigned* values, std::size_t n)
 {
+    ++device_activity().allocations;
     if (n == 0) return;
     const thrust::reverse_iterator<unsigned*> last_first(values + n);
-    thrust::inclusive_scan(thrust::device, last_first, last_first + n, last_first, thrust::minimum<unsigned>());
+    detail::guarded("thrust::inclusive_scan (suffix minimum)", [&] {
+        thrust::inclusive_scan(thrust::device, last_first, last_first + n, last_first, thrust::minimum<unsigned>());
+    });
 }
 
 template <class T, class Transform, class Op>
 T transform_reduce(cuda, std::size_t n, const Transform& f, T init, Op op)
 {
+    ++device_activity().allocations;
+    ++device_activity().read_backs;
     thrust::counting_iterator<std::size_t> first(0);
-    return thrust::transform_reduce(thrust::device, first, first + n, f, init, op);
+    return detail::guarded("thrust::transform_reduce",
+                           [&] { return thrust::transform_reduce(thrust::device, first, first + n, f, init, op); });
 }
 #endif
 

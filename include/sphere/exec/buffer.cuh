@@ -1,11 +1,15 @@
 #pragma once
 /// \file
-/// `buffer<T, Policy>`: an owning array in the memory space of a policy.
+/// `buffer<T, Policy>`: an owning array in the memory space of a policy. Every allocation (a
+/// buffer made or grown beyond its capacity) and every copy to the host counts in
+/// device_activity() on both backends.
 #include <cstddef>
 #include <utility>
 #include <vector>
 
 #include "../core/config.cuh"
+#include "activity.cuh"
+#include "cuda_error.cuh"
 #include "policy.cuh"
 
 #if SPHERE_CUDA_COMPILER
@@ -18,21 +22,54 @@ namespace sphere {
 template <class T, class Policy>
 class buffer;
 
+namespace detail {
+/// Counts an allocation when `size` values do not fit `capacity`.
+inline void count_growth(std::size_t size, std::size_t capacity)
+{
+    if (size > capacity) ++device_activity().allocations;
+}
+} // namespace detail
+
 /// Host memory (a std::vector underneath).
 template <class T>
 class buffer<T, host> {
 public:
     using value_type = T;
     buffer() = default;
-    explicit buffer(std::size_t n, const T& value = T{}) : data_(n, value) {}
+    explicit buffer(std::size_t n, const T& value = T{}) : data_((detail::count_growth(n, 0), n), value) {}
+    buffer(const buffer& other) : data_((detail::count_growth(other.size(), 0), other.data_)) {}
+    buffer(buffer&&) noexcept = default;
+    buffer& operator=(const buffer& other)
+    {
+        detail::count_growth(other.size(), data_.capacity());
+        data_ = other.data_;
+        return *this;
+    }
+    buffer& operator=(buffer&&) noexcept = default;
 
     std::size_t size() const { return data_.size(); }
     T* data() { return data_.data(); }
     const T* data() const { return data_.data(); }
-    void resize(std::size_t n, const T& value = T{}) { data_.resize(n, value); }
-    void assign(const std::vector<T>& values) { data_ = values; }
-    void assign(std::vector<T>&& values) { data_ = std::move(values); }
-    std::vector<T> to_host() const { return data_; }
+    void resize(std::size_t n, const T& value = T{})
+    {
+        detail::count_growth(n, data_.capacity());
+        data_.resize(n, value);
+    }
+    void assign(const std::vector<T>& values)
+    {
+        detail::count_growth(values.size(), data_.capacity());
+        data_ = values;
+    }
+    void assign(std::vector<T>&& values)
+    {
+        detail::count_growth(values.size(), data_.capacity());
+        data_ = std::move(values);
+    }
+    std::vector<T> to_host() const
+    {
+        ++device_activity().read_backs;
+        return data_;
+    }
     void swap(buffer& other) noexcept { data_.swap(other.data_); }
 
 private:
@@ -46,17 +83,35 @@ class buffer<T, cuda> {
 public:
     using value_type = T;
     buffer() = default;
-    explicit buffer(std::size_t n, const T& value = T{}) : data_(n, value) {}
+    explicit buffer(std::size_t n, const T& value = T{}) { resize(n, value); }
+    buffer(const buffer& other) { *this = other; }
+    buffer(buffer&&) noexcept = default;
+    buffer& operator=(const buffer& other)
+    {
+        detail::count_growth(other.size(), data_.capacity());
+        detail::guarded("a device allocation (buffer copy)", [&] { data_ = other.data_; });
+        return *this;
+    }
+    buffer& operator=(buffer&&) noexcept = default;
 
     std::size_t size() const { return data_.size(); }
     T* data() { return thrust::raw_pointer_cast(data_.data()); }
     const T* data() const { return thrust::raw_pointer_cast(data_.data()); }
-    void resize(std::size_t n, const T& value = T{}) { data_.resize(n, value); }
-    void assign(const std::vector<T>& values) { data_.assign(values.begin(), values.end()); }
+    void resize(std::size_t n, const T& value = T{})
+    {
+        detail::count_growth(n, data_.capacity());
+        detail::guarded("a device allocation (buffer resize)", [&] { data_.resize(n, value); });
+    }
+    void assign(const std::vector<T>& values)
+    {
+        detail::count_growth(values.size(), data_.capacity());
+        detail::guarded("a copy to the device (buffer assign)", [&] { data_.assign(values.begin(), values.end()); });
+    }
     std::vector<T> to_host() const
     {
+        ++device_activity().read_backs;
         std::vector<T> out(data_.size());
-        thrust::copy(data_.begin(), data_.end(), out.begin());
+        detail::guarded("a copy to the host (buffer to_host)", [&] { thrust::copy(data_.begin(), data_.end(), out.begin()); });
         return out;
     }
     void swap(buffer& other) noexcept { data_.swap(other.data_); }

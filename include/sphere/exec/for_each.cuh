@@ -10,6 +10,7 @@
 
 #include "../core/config.cuh"
 #include "../core/error.cuh"
+#include "cuda_error.cuh"
 #include "host_team.cuh"
 #include "policy.cuh"
 
@@ -59,11 +60,6 @@ __global__ void for_each_index_kernel(std::size_t n, Body body)
     for (std::size_t i = blockIdx.x * static_cast<std::size_t>(blockDim.x) + threadIdx.x; i < n; i += stride)
         body(i);
 }
-
-inline void check_cuda(cudaError_t status, const char* what)
-{
-    if (status != cudaSuccess) fail("CUDA error in ", what, ": ", cudaGetErrorString(status));
-}
 } // namespace detail
 
 template <class Body>
@@ -74,7 +70,7 @@ void for_each_index(cuda, std::size_t n, const Body& body)
     const std::size_t wanted = (n + threads - 1) / threads;
     const unsigned blocks = static_cast<unsigned>(wanted < 65535u * 32u ? wanted : 65535u * 32u);
     detail::for_each_index_kernel<<<blocks, threads>>>(n, body);
-    detail::check_cuda(cudaGetLastError(), "kernel launch");
+    detail::check_cuda(cudaGetLastError(), detail::kernel_name<Body>());
 }
 #endif
 

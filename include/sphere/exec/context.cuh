@@ -1,0 +1,159 @@
+#pragma once
+/// \file
+/// `execution_context<Policy>`: what a simulation's step needs from its backend beyond kernel
+/// launches: temporary storage that is kept between calls (a reduction allocates once, at its
+/// first call, not at every step), reductions whose result stays in the policy's memory
+/// (`transform_reduce_into`), and the step's one read-back (`read_back`), which on CUDA is also
+/// where an asynchronous fault of an earlier kernel surfaces as a sphere::error naming it.
+///
+/// The host backend goes through the same calls, and both count what the CUDA build does in
+/// device_activity() (exec/activity.cuh): a scratch block that grows is an allocation, a
+/// read_back is a read-back. Kernels launch on the default stream on CUDA (as for_each_index
+/// does), so the context's calls are ordered with them.
+#include <cstddef>
+#include <cstring>
+#include <utility>
+#include <vector>
+
+#include "../core/config.cuh"
+#include "../core/error.cuh"
+#include "activity.cuh"
+#include "algorithms.cuh"
+#include "cuda_error.cuh"
+#include "for_each.cuh"
+#include "policy.cuh"
+
+#if SPHERE_CUDA_COMPILER
+#include <cub/device/device_reduce.cuh>
+#include <thrust/iterator/counting_iterator.h>
+#include <thrust/iterator/transform_iterator.h>
+#endif
+
+namespace sphere {
+
+template <class Policy>
+class execution_context;
+
+/// Host: scratch in host memory; a read-back is a copy.
+template <>
+class execution_context<host> {
+public:
+    /// At least `bytes` of temporary storage, valid until the next call; grows, never shrinks.
+    void* scratch(std::size_t bytes)
+    {
+        if (bytes > scratch_.size()) {
+            ++device_activity().allocations;
+            scratch_.resize(bytes);
+        }
+        return scratch_.data();
+    }
+
+    /// Copies `count` values from the policy's memory at `from` to the host at `to`, after
+    /// everything launched before; `what` and `step` (of the simulation) name it in errors.
+    template <class T>
+    void read_back(T* to, const T* from, std::size_t count, const char* /*what*/, std::size_t /*step*/)
+    {
+        ++device_activity().read_backs;
+        std::memcpy(static_cast<void*>(to), static_cast<const void*>(from), count * sizeof(T));
+    }
+
+private:
+    std::vector<unsigned char> scratch_;
+};
+
+/// *out = init op f(0) op ... op f(n-1), written to the policy's memory at `out` (nothing is
+/// read back); on the host in the fixed order of detail::host_reduce, so bit-identical for any
+/// number of threads. T must be trivially copyable.
+template <class T, class Transform, class Op>
+void transform_reduce_into(execution_context<host>& ctx, std::size_t n, const Transform& f, T init, Op op, T* out)
+{
+    T* partial = static_cast<T*>(ctx.scratch(detail::host_reduce_chunks(n) * sizeof(T)));
+    *out = detail::host_reduce(n, f, init, op, partial);
+}
+
+#if SPHERE_CUDA_COMPILER
+/// CUDA: scratch in device memory, the read-back through pinned host memory; both grow only.
+template <>
+class execution_context<cuda> {
+public:
+    execution_context() = default;
+    execution_context(const execution_context&) = delete;
+    execution_context& operator=(const execution_context&) = delete;
+    execution_context(execution_context&& other) noexcept { swap(other); }
+    execution_context& operator=(execution_context&& other) noexcept
+    {
+        swap(other);
+        return *this;
+    }
+    ~execution_context()
+    {
+        if (scratch_) cudaFree(scratch_);
+        if (pinned_) cudaFreeHost(pinned_);
+    }
+
+    void* scratch(std::size_t bytes)
+    {
+        if (bytes > scratch_bytes_) {
+            ++device_activity().allocations;
+            if (scratch_) detail::check_cuda(cudaFree(scratch_), "cudaFree (context scratch)");
+            scratch_ = nullptr;
+            scratch_bytes_ = 0;
+            detail::check_cuda(cudaMalloc(&scratch_, bytes), "cudaMalloc (context scratch)");
+            scratch_bytes_ = bytes;
+        }
+        return scratch_;
+    }
+
+    template <class T>
+    void read_back(T* to, const T* from, std::size_t count, const char* what, std::size_t step)
+    {
+        ++device_activity().read_backs;
+        const std::size_t bytes = count * sizeof(T);
+        if (bytes > pinned_bytes_) {
+            if (pinned_) detail::check_cuda(cudaFreeHost(pinned_), "cudaFreeHost (context read-back)");
+            pinned_ = nullptr;
+            pinned_bytes_ = 0;
+            detail::check_cuda(cudaMallocHost(&pinned_, bytes), "cudaMallocHost (context read-back)");
+            pinned_bytes_ = bytes;
+        }
+        detail::check_cuda(cudaMemcpyAsync(pinned_, from, bytes, cudaMemcpyDeviceToHost, 0), what);
+        const cudaError_t status = cudaStreamSynchronize(0);
+        if (status != cudaSuccess)
+            detail::fail("step ", step, ": CUDA error at ", what, " (a kernel launched since the last read-back faulted, or the copy did): ",
+                 cudaGetErrorString(status));
+        std::memcpy(static_cast<void*>(to), pinned_, bytes);
+    }
+
+private:
+    void swap(execution_context& other) noexcept
+    {
+        std::swap(scratch_, other.scratch_);
+        std::swap(scratch_bytes_, other.scratch_bytes_);
+        std::swap(pinned_, other.pinned_);
+        std::swap(pinned_bytes_, other.pinned_bytes_);
+    }
+
+    void* scratch_ = nullptr;
+    std::size_t scratch_bytes_ = 0;
+    void* pinned_ = nullptr;
+    std::size_t pinned_bytes_ = 0;
+};
+
+template <class T, class Transform, class Op>
+void transform_reduce_into(execution_context<cuda>& ctx, std::size_t n, const Transform& f, T init, Op op, T* out)
+{
+    if (n == 0) {
+        for_each_index(cuda{}, 1, detail::fill_value<T>{out, init});
+        return;
+    }
+    const auto in = thrust::make_transform_iterator(thrust::counting_iterator<std::size_t>(0), f);
+    std::size_t bytes = 0;
+    detail::check_cuda(cub::DeviceReduce::Reduce(nullptr, bytes, in, out, n, op, init, cudaStream_t(0)),
+                       "cub::DeviceReduce::Reduce (size query)");
+    void* temporary = ctx.scratch(bytes > 0 ? bytes : 1);
+    detail::check_cuda(cub::DeviceReduce::Reduce(temporary, bytes, in, out, n, op, init, cudaStream_t(0)),
+                       "cub::DeviceReduce::Reduce");
+}
+#endif
+
+} // namespace sphere
