@@ -1,5 +1,6 @@
-// Instantiates every kernel of the DEM core for sphere::cuda in float and double, with every
-// contact-law and integrator policy, so that CI proves the CUDA backend compiles and links.
+// Instantiates every kernel of the DEM core for sphere::cuda in float, double and mixed
+// precision, with every contact-law and integrator policy, so that CI proves the CUDA backend
+// compiles and links, and ptxas reports every kernel's resources (tests/check_ptxas.py).
 // It is built, not run: build machines have no GPU.
 #include <sphere/dem.cuh>
 
@@ -8,9 +9,10 @@
 
 namespace {
 
-template <class Real, class Law, class Integrator>
+template <class P, class Law, class Integrator>
 double exercise()
 {
+    using Real = sphere::coord_t<P>;
     sphere::settings<Real> s;
     s.box.lo = {0, 0, 0};
     s.box.hi = {Real(0.1), Real(0.1), Real(0.1)};
@@ -22,7 +24,7 @@ double exercise()
     particles[0].position = {Real(0.05), Real(0.05), Real(0.05)};
     particles[0].radius = Real(0.01);
     particles[0].density = Real(2500);
-    sphere::simulation<Real, sphere::cuda, Law, Integrator> sim(s, particles);
+    sphere::simulation<P, sphere::cuda, Law, Integrator> sim(s, particles);
     sim.step();
     sim.set_velocity(0, {1, 0, 0}, {0, 0, 0});
     const auto e = sim.energy();
@@ -30,19 +32,31 @@ double exercise()
     return static_cast<double>(e.total() + p.x) + static_cast<double>(sim.snapshot().x[0].x);
 }
 
-template <class Real>
+template <class P>
 double exercise_all()
 {
     using namespace sphere;
     using visco = contact::linear<tangential::visco_frictional, tangential::visco_frictional>;
-    return exercise<Real, contact::linear<>, integrate::semi_implicit_euler>() +
-           exercise<Real, visco, integrate::taylor2>() + exercise<Real, contact::linear<>, integrate::explicit_euler>();
+    return exercise<P, contact::linear<>, integrate::semi_implicit_euler>() + exercise<P, visco, integrate::taylor2>() +
+           exercise<P, contact::linear<>, integrate::explicit_euler>();
+}
+
+/// The step's two shapes (integration after the forces, and velocity Verlet's drift before
+/// them) in precision P.
+template <class P>
+double exercise_step_shapes()
+{
+    using namespace sphere;
+    return exercise<P, contact::linear<>, integrate::semi_implicit_euler>() +
+           exercise<P, contact::linear<>, integrate::velocity_verlet>();
 }
 
 } // namespace
 
 int main()
 {
-    std::printf("%g\n", exercise_all<float>() + exercise_all<double>());
+    std::printf("%g\n", exercise_all<float>() + exercise_all<double>() +
+                                exercise<double, sphere::contact::linear<>, sphere::integrate::velocity_verlet>() +
+                                exercise_step_shapes<sphere::mixed>());
     return 0;
 }

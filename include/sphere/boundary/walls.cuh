@@ -37,12 +37,7 @@ struct wall_set {
     }
 
     /// Unit normal of face f pointing into the world (m/m).
-    SPHERE_HD static vec3<Real> inward_normal(int f)
-    {
-        vec3<Real> n{0, 0, 0};
-        n[f / 2] = f % 2 == 0 ? Real(1) : Real(-1);
-        return n;
-    }
+    SPHERE_HDI static vec3<Real> inward_normal(int f) { return along_axis(f / 2, f % 2 == 0 ? Real(1) : Real(-1)); }
 };
 
 } // namespace sphere

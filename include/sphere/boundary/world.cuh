@@ -22,7 +22,11 @@ struct world {
     boundary axis[3] = {boundary::wall, boundary::wall, boundary::wall};
 
     SPHERE_HDI Real length(int a) const { return hi[a] - lo[a]; }
-    SPHERE_HDI bool periodic(int a) const { return axis[a] == boundary::periodic; }
+    /// Whether axis a is periodic (selects, not an index: see component() in core/vec.cuh).
+    SPHERE_HDI bool periodic(int a) const
+    {
+        return (a == 0 ? axis[0] : (a == 1 ? axis[1] : axis[2])) == boundary::periodic;
+    }
 
     /// The shortest image of a separation vector d (m): on periodic axes d - L round(d / L).
     SPHERE_HD vec3<Real> nearest_image(vec3<Real> d) const

@@ -175,26 +175,28 @@ struct neighbour_scan {
     template <class Visit>
     SPHERE_HD void operator()(std::size_t k, Visit& visit) const
     {
+        // Cell coordinates along the slow, mid and fast axes, in scalars (arrays indexed by
+        // run-time axes would live in local memory on CUDA).
         const grid_geometry<Real>& g = grid.geometry;
         const vec4<Real> xi = grid.sorted_x[k];
-        int ci[3];
-        for (int a = 0; a < 3; ++a) ci[a] = g.coordinate(xi.xyz()[a], a);
-        const int layers = static_cast<int>(g.n[g.slow]), nf = static_cast<int>(g.n[g.fast]);
+        const int cs = g.coordinate(component(xi.xyz(), g.slow), g.slow);
+        const int cm = g.coordinate(component(xi.xyz(), g.mid), g.mid);
+        const int cf = g.coordinate(component(xi.xyz(), g.fast), g.fast);
+        const int layers = static_cast<int>(g.cells(g.slow)), nf = static_cast<int>(g.cells(g.fast));
         for (int ds = 0; ds <= 1; ++ds) {
-            int c[3] = {ci[0], ci[1], ci[2]};
-            c[g.slow] += ds;
-            if (c[g.slow] == layers) {
+            int s = cs + ds;
+            if (s == layers) {
                 // the next layer of the last one: the first, on a periodic axis with more than
                 // two layers (with two, the first is also the previous one and owns the pair)
                 if (!g.box.periodic(g.slow) || layers < 3) continue;
-                c[g.slow] = 0;
+                s = 0;
             }
             for (int dm = -1; dm <= 1; ++dm) {
-                c[g.mid] = ci[g.mid] + dm;
-                if (!wrap_or_reject(c[g.mid], g.mid)) continue;
-                // The cells ci[fast] - 1 .. ci[fast] + 1 along the fast axis: one run of ranks,
-                // or two when a periodic axis wraps around.
-                int f0 = ci[g.fast] - 1, f1 = ci[g.fast] + 1;
+                int m = cm + dm;
+                if (!wrap_or_reject(m, g.mid)) continue;
+                // The cells cf - 1 .. cf + 1 along the fast axis: one run of ranks, or two when
+                // a periodic axis wraps around.
+                int f0 = cf - 1, f1 = cf + 1;
                 int wrapped0 = 0, wrapped1 = -1;
                 if (g.box.periodic(g.fast)) {
                     if (f0 < 0) { wrapped0 = wrapped1 = nf - 1; f0 = 0; }
@@ -204,30 +206,25 @@ struct neighbour_scan {
                     f1 = f1 >= nf ? nf - 1 : f1;
                 }
                 const std::size_t above = ds == 0 ? k + 1 : 0; // same layer: higher ranks only
-                scan_run(xi, run_cell(c, f0), run_cell(c, f1), above, visit);
-                if (wrapped1 >= 0) scan_run(xi, run_cell(c, wrapped0), run_cell(c, wrapped1), above, visit);
+                scan_run(xi, g.index_in_order(s, m, f0), g.index_in_order(s, m, f1), above, visit);
+                if (wrapped1 >= 0) scan_run(xi, g.index_in_order(s, m, wrapped0), g.index_in_order(s, m, wrapped1), above, visit);
             }
         }
+        SPHERE_UNROLL
         for (int f = 0; f < wall_set<Real>::count; ++f) {
             const wall_face<Real>& w = walls.face[f];
-            if (!w.active) continue;
             const int a = f / 2;
-            const Real gap = (xi.xyz()[a] - Real(w.position)) * wall_set<Real>::inward_normal(f)[a] - xi.w;
-            if (gap < skin) visit.wall(f);
+            const Real gap =
+                (component(xi.xyz(), a) - Real(w.position)) * component(wall_set<Real>::inward_normal(f), a) - xi.w;
+            if (w.active && gap < skin) visit.wall(f);
         }
     }
 
 private:
-    SPHERE_HD unsigned run_cell(int c[3], int f) const
-    {
-        c[grid.geometry.fast] = f;
-        return grid.geometry.index(c);
-    }
-
     /// Wraps cell coordinate c on a periodic axis; false when it lies outside a wall axis.
     SPHERE_HD bool wrap_or_reject(int& c, int a) const
     {
-        const int n = static_cast<int>(grid.geometry.n[a]);
+        const int n = static_cast<int>(grid.geometry.cells(a));
         if (grid.geometry.box.periodic(a)) {
             c = (c + n) % n;
             return true;

@@ -172,19 +172,29 @@ struct wall_contacts {
         for (unsigned e = c.offset[r + 1]; e > first && c.partner[e - 1] >= wall_partner_base; --e) {
             const unsigned k = e - 1;
             const int f = static_cast<int>(c.partner[k] - wall_partner_base);
-            const wall_face<Coord>& wall = walls.face[f];
+            // The face's fields by constant indices (SPHERE_UNROLL) and the axis's components
+            // by selects: run-time indexing would put this kernel's parameters in local memory
+            // on CUDA.
+            double position = 0, wall_velocity = 0;
+            SPHERE_UNROLL
+            for (int g = 0; g < wall_set<Coord>::count; ++g) {
+                position = g == f ? walls.face[g].position : position;
+                wall_velocity = g == f ? walls.face[g].velocity : wall_velocity;
+            }
             const int a = f / 2;
-            vec3<Real> n = wall_set<Real>::inward_normal(f);
-            const Coord dist_c = (xi.xyz()[a] - Coord(wall.position)) * Coord(n[a]);
+            const vec3<Real> n = wall_set<Real>::inward_normal(f);
+            const Coord dist_c = (component(xi.xyz(), a) - Coord(position)) * Coord(component(n, a));
             const Real dist = Real(dist_c), delta_n = Real(dist_c - xi.w);
             vec4<Real> h = c.history.load(k);
             if (delta_n < Real(0)) {
                 contact_motion<Real> m{n, delta_n, vi + dist * cross(n, wi), si + dist * cross(n, ti), p.mass[i]};
-                m.velocity[a] -= Real(wall.velocity);
+                m.velocity -= along_axis(a, Real(wall_velocity)); // 0 subtracted on the other axes
                 if (OneVelocity) m.step = m.velocity * dt;
-                else m.step[a] -= Real(wall.velocity) * dt;
+                else m.step -= along_axis(a, Real(wall_velocity) * dt);
                 contact_result<Real> r = Law::wall(params, m, h, dt);
-                loads.force[f] = -double(r.normal[a] + r.tangential[a]);
+                const double load = -double(component(r.normal, a) + component(r.tangential, a));
+                SPHERE_UNROLL
+                for (int g = 0; g < wall_set<Coord>::count; ++g) loads.force[g] = g == f ? load : loads.force[g];
                 force += r.normal + r.tangential;
                 torque -= dist * cross(n, r.tangential);
                 if (Book) {

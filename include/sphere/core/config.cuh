@@ -34,6 +34,17 @@
 #define SPHERE_VECTORISE_LOOP _Pragma("omp simd")
 #endif
 
+/// SPHERE_UNROLL before a loop with a constant trip count whose index selects struct members
+/// (the six wall faces): unrolled, every index is a constant and the members stay in
+/// registers on CUDA instead of local memory.
+#if defined(__CUDACC__)
+#define SPHERE_UNROLL _Pragma("unroll")
+#elif defined(__GNUC__) && !defined(__clang__)
+#define SPHERE_UNROLL _Pragma("GCC unroll 8")
+#else
+#define SPHERE_UNROLL
+#endif
+
 #if defined(__CUDA_ARCH__)
 #define SPHERE_DEVICE_CODE 1
 #else

@@ -21,6 +21,22 @@ struct vec3 {
     SPHERE_HDI vec3& operator*=(Real s) { x *= s; y *= s; z *= s; return *this; }
 };
 
+/// Component a (0, 1 or 2) of v, by selects. Kernels index vectors with a run-time axis this
+/// way (or through the const operator[]): the reference that the non-const operator[] returns
+/// makes nvcc keep the vector, and often the kernel's whole parameter block, in local memory.
+template <class Real>
+SPHERE_HDI Real component(const vec3<Real>& v, int a)
+{
+    return a == 0 ? v.x : (a == 1 ? v.y : v.z);
+}
+
+/// The vector with s on axis a (0, 1 or 2) and zeros on the others.
+template <class Real>
+SPHERE_HDI vec3<Real> along_axis(int a, Real s)
+{
+    return {a == 0 ? s : Real(0), a == 1 ? s : Real(0), a == 2 ? s : Real(0)};
+}
+
 /// Position and radius packed 4-wide (x, y, z, r) so that one aligned load reads both.
 template <class Real>
 struct alignas(4 * sizeof(Real)) vec4 {

@@ -20,6 +20,7 @@
 
 #include "../core/config.cuh"
 #include "activity.cuh"
+#include "buffer.cuh"
 #include "cuda_error.cuh"
 #include "for_each.cuh"
 #include "host_team.cuh"
@@ -30,8 +31,8 @@
 #include <thrust/functional.h>
 #include <thrust/iterator/counting_iterator.h>
 #include <thrust/iterator/reverse_iterator.h>
+#include <thrust/reduce.h>
 #include <thrust/scan.h>
-#include <thrust/transform_reduce.h>
 #endif
 
 namespace sphere {
@@ -85,6 +86,14 @@ inline void suffix_min_in_place(host, unsigned* values, std::size_t n)
 }
 
 namespace detail {
+/// values[i] = f(i): a reduction's transform as a kernel of its own (CUDA).
+template <class T, class Transform>
+struct store_values {
+    Transform f;
+    T* values;
+    SPHERE_HD void operator()(std::size_t i) const { values[i] = f(i); }
+};
+
 /// Number of partial results of a host reduction over n indices.
 inline std::size_t host_reduce_chunks(std::size_t n) { return (n + host_chunk - 1) / host_chunk; }
 
@@ -124,7 +133,7 @@ T host_reduce(std::size_t n, const Transform& f, T init, Op op, T* partial)
 template <class T, class Transform, class Op>
 T transform_reduce(host, std::size_t n, const Transform& f, T init, Op op)
 {
-    ++device_activity().allocations;
+    device_activity().allocations += 2; // on CUDA: the array of values and the reduction's storage
     ++device_activity().read_backs;
     std::vector<T> partial(detail::host_reduce_chunks(n), init);
     return detail::host_reduce(n, f, init, op, partial.data());
@@ -166,11 +175,16 @@ inline void suffix_min_in_place(cuda, unsigned* values, std::size_t n)
 template <class T, class Transform, class Op>
 T transform_reduce(cuda, std::size_t n, const Transform& f, T init, Op op)
 {
-    ++device_activity().allocations;
+    // The transform runs in a kernel of its own, one index per thread, into an array that a
+    // plain reduction then combines: inlined into the reduction, which unrolls several indices
+    // per thread, a heavy transform spills registers (tests/check_ptxas.py).
+    ++device_activity().allocations; // the reduction's storage (the array counts itself)
     ++device_activity().read_backs;
-    thrust::counting_iterator<std::size_t> first(0);
-    return detail::guarded("thrust::transform_reduce",
-                           [&] { return thrust::transform_reduce(thrust::device, first, first + n, f, init, op); });
+    if (n == 0) return init;
+    buffer<T, cuda> values(n);
+    for_each_index(cuda{}, n, detail::store_values<T, Transform>{f, values.data()});
+    T* first = values.data();
+    return detail::guarded("thrust::reduce", [&] { return thrust::reduce(thrust::device, first, first + n, init, op); });
 }
 #endif
 

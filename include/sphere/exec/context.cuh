@@ -25,8 +25,6 @@
 
 #if SPHERE_CUDA_COMPILER
 #include <cub/device/device_reduce.cuh>
-#include <thrust/iterator/counting_iterator.h>
-#include <thrust/iterator/transform_iterator.h>
 #endif
 
 namespace sphere {
@@ -146,12 +144,18 @@ void transform_reduce_into(execution_context<cuda>& ctx, std::size_t n, const Tr
         for_each_index(cuda{}, 1, detail::fill_value<T>{out, init});
         return;
     }
-    const auto in = thrust::make_transform_iterator(thrust::counting_iterator<std::size_t>(0), f);
+    // The transform runs in a kernel of its own, one index per thread, into the scratch; CUB
+    // then reduces the plain array (see transform_reduce in exec/algorithms.cuh).
+    const std::size_t aligned = 256, value_bytes = (n * sizeof(T) + aligned - 1) / aligned * aligned;
     std::size_t bytes = 0;
-    detail::check_cuda(cub::DeviceReduce::Reduce(nullptr, bytes, in, out, n, op, init, cudaStream_t(0)),
+    detail::check_cuda(cub::DeviceReduce::Reduce(nullptr, bytes, static_cast<const T*>(nullptr), out, n, op, init,
+                                                 cudaStream_t(0)),
                        "cub::DeviceReduce::Reduce (size query)");
-    void* temporary = ctx.scratch(bytes > 0 ? bytes : 1);
-    detail::check_cuda(cub::DeviceReduce::Reduce(temporary, bytes, in, out, n, op, init, cudaStream_t(0)),
+    unsigned char* base = static_cast<unsigned char*>(ctx.scratch(value_bytes + bytes));
+    T* values = reinterpret_cast<T*>(base);
+    for_each_index(cuda{}, n, detail::store_values<T, Transform>{f, values});
+    detail::check_cuda(cub::DeviceReduce::Reduce(base + value_bytes, bytes, static_cast<const T*>(values), out, n, op,
+                                                 init, cudaStream_t(0)),
                        "cub::DeviceReduce::Reduce");
 }
 #endif

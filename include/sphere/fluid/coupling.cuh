@@ -44,16 +44,20 @@ struct coupling_options {
 
 namespace detail {
 
-/// The fluid force on particle i (N), and its response time m / (drag coefficient) (s).
+/// The fluid force on particle i (N), and its response time m / (drag coefficient) (s). A
+/// kernel of its own, whose response times a plain reduction then takes the least of: inlined
+/// into a CUB reduction (which unrolls several items per thread) the drag laws spill
+/// registers (tests/check_ptxas.py).
 template <class Real, class Drag>
 struct fluid_particle_force {
     fluid_view<Real> f;
     porosity_view<Real> por;
     particle_view<Real> p;
     vec3<Real>* out;
+    Real* response;
     bool pressure_force;
 
-    SPHERE_HD Real operator()(std::size_t i) const
+    SPHERE_HD void operator()(std::size_t i) const
     {
         const vec4<Real> x = p.x[i];
         int cell[3];
@@ -70,8 +74,15 @@ struct fluid_particle_force {
         vec3<Real> force = rel * k;
         if (pressure_force) force += drag::pressure_gradient_force(V, f.pressure_gradient(c));
         out[i] = force;
-        return k > Real(0) ? p.mass[i] / k : Real(1e30);
+        response[i] = k > Real(0) ? p.mass[i] / k : Real(1e30);
     }
+};
+
+/// values[i] (a reduction's transform over an array).
+template <class T>
+struct value_at {
+    const T* values;
+    SPHERE_HDI T operator()(std::size_t i) const { return values[i]; }
 };
 
 /// The force density on the fluid in each cell (N/m^3): minus the sum of the forces on the
@@ -152,10 +163,12 @@ public:
         porosity_.update(p, dt);
         fluid_.set_porosity(porosity_.view());
         vec3<Real>* forces = sim.external_forces();
-        const Real response = transform_reduce(
-            Policy{}, p.n,
-            detail::fluid_particle_force<Real, Drag>{fluid_.view(), porosity_.view(), p, forces, options_.pressure_force},
-            Real(1e30), min_op{});
+        if (response_.size() != p.n) response_ = buffer<Real, Policy>(p.n);
+        for_each_index(Policy{}, p.n,
+                       detail::fluid_particle_force<Real, Drag>{fluid_.view(), porosity_.view(), p, forces,
+                                                                response_.data(), options_.pressure_force});
+        const Real response =
+            transform_reduce(Policy{}, p.n, detail::value_at<Real>{response_.data()}, Real(1e30), min_op{});
         if (!(dt <= response))
             detail::fail("coupling: the fluid step ", dt, " s (", options_.dem_steps, " DEM steps of ", sim.dt(),
                          " s) exceeds the shortest particle response time m / (drag coefficient) = ", response,
@@ -183,6 +196,7 @@ private:
     porosity_estimator<Real, Policy> porosity_;
     navier_stokes<Real, Policy, Poisson> fluid_;
     buffer<vec4<Real>, Policy> x_before_;  ///< positions at the start of the DEM steps, by user index
+    buffer<Real, Policy> response_;        ///< each particle's response time to the drag (s)
     double work_ = 0;                      ///< work_on_particles() (J)
 };
 

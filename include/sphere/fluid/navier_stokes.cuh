@@ -52,7 +52,11 @@ struct fluid_view {
     /// every x and y face; the z faces between two cells.
     SPHERE_HD bool active_face(int a, int k) const { return a != 2 || (k >= 0 && k < int(grid.n[2]) - 1); }
     /// Porosity on face (c, a): the mean of the two cells it separates.
-    SPHERE_HD Real phi_face(long long c, int a) const { return Real(0.5) * (phi[c] + phi[c + stride[a]]); }
+    SPHERE_HD Real phi_face(long long c, int a) const { return Real(0.5) * (phi[c] + phi[c + stride_of(a)]); }
+    /// The face velocities of axis a and the field stride along it, chosen by selects for a
+    /// run-time axis (see component() in core/vec.cuh).
+    SPHERE_HDI const Real* velocity_of(int a) const { return a == 0 ? u[0] : (a == 1 ? u[1] : u[2]); }
+    SPHERE_HDI long long stride_of(int a) const { return a == 0 ? stride[0] : (a == 1 ? stride[1] : stride[2]); }
     /// The fluid velocity at the centre of cell c: the mean of its two faces per axis.
     SPHERE_HD vec3<Real> cell_velocity(long long c) const
     {
@@ -327,7 +331,7 @@ struct face_momentum {
         int k;
         const long long c = f.cell_field(cell, k);
         if (!f.active_face(a, k)) return 0;
-        return double(f.phi_face(c, a)) * double(f.u[a][c]);
+        return double(f.phi_face(c, a)) * double(f.velocity_of(a)[c]);
     }
 };
 

@@ -26,30 +26,34 @@ struct grid_geometry {
     int fast = 0, mid = 1, slow = 2; ///< axes in the order of the cell numbering
 
     SPHERE_HD std::size_t cell_count() const { return std::size_t(n[0]) * n[1] * n[2]; }
+    /// Cells along axis a. Kernels read n and the axes' properties through selects like
+    /// this one, never by a run-time index (see component() in core/vec.cuh).
+    SPHERE_HDI unsigned cells(int a) const { return a == 0 ? n[0] : (a == 1 ? n[1] : n[2]); }
     /// Cells in one layer across the slow axis.
-    SPHERE_HD unsigned cells_per_layer() const { return n[fast] * n[mid]; }
+    SPHERE_HD unsigned cells_per_layer() const { return cells(fast) * cells(mid); }
     /// Layers along the slow axis.
-    SPHERE_HD unsigned layers() const { return n[slow]; }
+    SPHERE_HD unsigned layers() const { return cells(slow); }
 
     /// Cell coordinate of c along axis a, clamped into the grid.
     SPHERE_HD int coordinate(Real c, int a) const
     {
-        const Real f = std::floor((c - box.lo[a]) / width[a]);
+        const unsigned na = cells(a);
+        const Real f = std::floor((c - component(box.lo, a)) / component(width, a));
         if (!(f > Real(0))) return 0;
-        if (f >= Real(n[a] - 1)) return static_cast<int>(n[a] - 1);
+        if (f >= Real(na - 1)) return static_cast<int>(na - 1);
         return static_cast<int>(f);
     }
 
-    /// The number of the cell with coordinates c[0], c[1], c[2] along x, y, z.
-    SPHERE_HD unsigned index(const int c[3]) const
+    /// The number of the cell with coordinates s, m, f along the slow, mid and fast axes.
+    SPHERE_HD unsigned index_in_order(int s, int m, int f) const
     {
-        return (static_cast<unsigned>(c[slow]) * n[mid] + static_cast<unsigned>(c[mid])) * n[fast] +
-               static_cast<unsigned>(c[fast]);
+        return (static_cast<unsigned>(s) * cells(mid) + static_cast<unsigned>(m)) * cells(fast) + static_cast<unsigned>(f);
     }
+    /// The number of the cell with coordinates ix, iy, iz along x, y, z.
     SPHERE_HD unsigned index(int ix, int iy, int iz) const
     {
-        const int c[3] = {ix, iy, iz};
-        return index(c);
+        const auto pick = [&](int a) { return a == 0 ? ix : (a == 1 ? iy : iz); };
+        return index_in_order(pick(slow), pick(mid), pick(fast));
     }
 
     SPHERE_HD unsigned cell_of(const vec3<Real>& p) const
