@@ -117,8 +117,9 @@ public:
         detail::check_cuda(cudaMemcpyAsync(pinned_, from, bytes, cudaMemcpyDeviceToHost, 0), what);
         const cudaError_t status = cudaStreamSynchronize(0);
         if (status != cudaSuccess)
-            detail::fail("step ", step, ": CUDA error at ", what, " (a kernel launched since the last read-back faulted, or the copy did): ",
-                 cudaGetErrorString(status));
+            detail::fail("step ", step, ": CUDA error at ", what,
+                         " (a kernel launched since the last read-back faulted, or the copy did): ",
+                         cudaGetErrorString(status));
         std::memcpy(static_cast<void*>(to), pinned_, bytes);
     }
 
