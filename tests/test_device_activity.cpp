@@ -4,9 +4,13 @@
 // so these counts are the CUDA build's.
 // - the counters count: a buffer that grows, a copy to the host, a reduction returned to the
 //   host, the context's scratch (once, however often it is reused) and its read-back;
-// - a step without a rebuild, with an upper wall under stress control and a prescribed
-//   particle (whose drive power the step sums), on both pair schedules (the gather schedule is
-//   the one CUDA runs), allocates nothing after warm-up and reads back exactly one struct.
+// - a step with or without a rebuild, with an upper wall under stress control and a
+//   prescribed particle (whose drive power the step sums), on both pair schedules (the gather
+//   schedule is the one CUDA runs), with and without reordering the particles, with
+//   semi-implicit Euler and velocity Verlet, allocates nothing after warm-up and reads back
+//   exactly one struct;
+// - a rebuild whose lists outgrow their capacity runs the step again with room, to the same
+//   bits as a run that had the room from the start.
 #include <catch2/catch.hpp>
 
 #include <random>
@@ -27,6 +31,42 @@ sphere::device_activity_counts since(const sphere::device_activity_counts& start
 struct index_value {
     SPHERE_HD double operator()(std::size_t i) const { return double(i); }
 };
+
+/// 6 x 6 x 6 equal spheres, columns 2.2 R apart in x and y (jittered), layers 1.98 R apart in
+/// z, pressed by 0.01 R onto the floor, each other and an upper wall held at 1 kPa; periodic
+/// in x and y, with gravity; particle 0 is prescribed at rest (the step sums its drive's
+/// power). The overlaps ring with amplitudes of ~0.01 R.
+template <class P, class Integrator>
+sphere::simulation<P, sphere::host, sphere::contact::linear<>, Integrator>
+pressed_lattice(sphere::pair_summation how, double skin_in_radii, bool reorder)
+{
+    using Real = sphere_test::user_real<P>;
+    const Real R = sphere_test::set_p<Real>::radius, spacing = Real(2.2) * R, layer = Real(1.98) * R;
+    sphere::settings<Real> s = sphere_test::frictional_box<Real>(1);
+    s.box.lo = {0, 0, 0};
+    const Real top = Real(0.99) * R + 5 * layer + Real(0.99) * R;
+    s.box.hi = {6 * spacing, 6 * spacing, 2 * top};
+    s.box.axis[0] = s.box.axis[1] = sphere::boundary::periodic;
+    s.walls[5].mode = sphere::wall_mode::stress;
+    s.walls[5].stress = Real(1e3);
+    s.walls[5].mass = Real(0.5);
+    s.skin = Real(skin_in_radii) * R;
+    s.pair_summation = how;
+    s.reorder = reorder;
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<double> u(-1, 1);
+    std::vector<sphere::particle<Real>> p;
+    for (int k = 0; k < 6; ++k)
+        for (int j = 0; j < 6; ++j)
+            for (int i = 0; i < 6; ++i)
+                p.push_back(sphere_test::ball<Real>({Real((i + 0.5 + 0.05 * u(rng)) * spacing),
+                                                     Real((j + 0.5 + 0.05 * u(rng)) * spacing),
+                                                     Real(0.99) * R + Real(k) * layer}));
+    p[0].kind = sphere::motion::prescribed;
+    sphere::simulation<P, sphere::host, sphere::contact::linear<>, Integrator> sim(s, p);
+    sim.set_wall_position(5, double(top));
+    return sim;
+}
 
 } // namespace
 
@@ -62,49 +102,86 @@ TEST_CASE("device activity: the counters count allocations and read-backs where 
     CHECK(since(before).read_backs == 1);
 }
 
-TEMPLATE_TEST_CASE("device activity: a step without a rebuild allocates nothing and reads back one struct",
-                   "[activity]", float, double, sphere::mixed)
+/// Counts what `steps` steps of the pressed lattice cost after a warm-up of 20 (the step's
+/// scratch, report and lists grow to what they need in it).
+template <class P, class Integrator>
+void count_steps(sphere::pair_summation how, double skin, bool reorder)
 {
-    using P = TestType;
-    using Real = sphere_test::user_real<P>;
-    const sphere::pair_summation how = GENERATE(sphere::pair_summation::slabs, sphere::pair_summation::gather);
-    // 6 x 6 x 6 equal spheres, columns 2.2 R apart in x and y (jittered), layers 1.98 R apart
-    // in z, pressed by 0.01 R onto the floor, each other and an upper wall held at 1 kPa;
-    // periodic in x and y, with gravity; particle 0 is prescribed at rest (the step sums its
-    // drive's power). The overlaps ring with amplitudes of ~0.01 R, far below the skin.
-    const Real R = sphere_test::set_p<Real>::radius, spacing = Real(2.2) * R, layer = Real(1.98) * R;
-    sphere::settings<Real> s = sphere_test::frictional_box<Real>(1);
-    s.box.lo = {0, 0, 0};
-    const Real top = Real(0.99) * R + 5 * layer + Real(0.99) * R;
-    s.box.hi = {6 * spacing, 6 * spacing, 2 * top};
-    s.box.axis[0] = s.box.axis[1] = sphere::boundary::periodic;
-    s.walls[5].mode = sphere::wall_mode::stress;
-    s.walls[5].stress = Real(1e3);
-    s.walls[5].mass = Real(0.5);
-    s.skin = Real(0.5) * R; // no rebuild in the counted window
-    s.pair_summation = how;
-    std::mt19937 rng(3);
-    std::uniform_real_distribution<double> u(-1, 1);
-    std::vector<sphere::particle<Real>> p;
-    for (int k = 0; k < 6; ++k)
-        for (int j = 0; j < 6; ++j)
-            for (int i = 0; i < 6; ++i)
-                p.push_back(sphere_test::ball<Real>({Real((i + 0.5 + 0.05 * u(rng)) * spacing),
-                                                     Real((j + 0.5 + 0.05 * u(rng)) * spacing),
-                                                     Real(0.99) * R + Real(k) * layer}));
-    p[0].kind = sphere::motion::prescribed;
-    sphere::simulation<P> sim(s, p);
-    sim.set_wall_position(5, double(top));
-    sim.run(20); // warm-up: the step's scratch and report are allocated once
-
-    const std::size_t rebuilds = sim.rebuilds(), steps = 100;
+    auto sim = pressed_lattice<P, Integrator>(how, skin, reorder);
+    sim.run(20);
+    const std::size_t rebuilds = sim.rebuilds(), overflows = sim.list_overflows(), steps = 100;
     const sphere::device_activity_counts start = sphere::device_activity();
     sim.run(steps);
     const sphere::device_activity_counts used = since(start);
-    INFO("pair summation " << unsigned(how) << ", rebuilds " << rebuilds << " -> " << sim.rebuilds());
-    REQUIRE(sim.rebuilds() == rebuilds); // the window is what it claims to be
+    INFO("pair summation " << unsigned(how) << ", reorder " << reorder << ", skin " << skin << " R, rebuilds "
+                           << rebuilds << " -> " << sim.rebuilds());
+    // the window is what it claims to be
+    REQUIRE(sim.rebuilds() == rebuilds + (skin > 0 ? 0 : steps));
+    REQUIRE(sim.list_overflows() == overflows);
     CHECK(sim.walls().face[5].force > 0); // the loads are in the report: the wall is pushed up,
     CHECK(sim.walls().face[4].force < 0); // the floor down (forces along the axis)
     CHECK(used.allocations == 0);
     CHECK(used.read_backs == steps);
+}
+
+TEMPLATE_TEST_CASE("device activity: a step allocates nothing after warm-up and reads back one struct, with or "
+                   "without a rebuild",
+                   "[activity]", float, double, sphere::mixed)
+{
+    const sphere::pair_summation how = GENERATE(sphere::pair_summation::slabs, sphere::pair_summation::gather);
+    const bool reorder = GENERATE(true, false);
+    // A skin of 0.5 R: no rebuild in the counted window (the overlaps ring far below it); a
+    // skin of 0: a rebuild before every step.
+    const double skin = GENERATE(0.5, 0.0);
+    SECTION("semi-implicit Euler") { count_steps<TestType, sphere::integrate::semi_implicit_euler>(how, skin, reorder); }
+    // its report also checks where the next drift puts the particles, so that the drift need
+    // not be checked and read back before the forces
+    SECTION("velocity Verlet") { count_steps<TestType, sphere::integrate::velocity_verlet>(how, skin, reorder); }
+}
+
+TEMPLATE_TEST_CASE("contact lists that outgrow their capacity run the step again, to the same bits", "[activity]",
+                   float, double, sphere::mixed)
+{
+    using P = TestType;
+    using Real = sphere_test::user_real<P>;
+    const bool reorder = GENERATE(true, false);
+    const double skin = GENERATE(0.1, 0.0);
+    // 4 x 4 x 4 spheres 2.3 R apart, thrown at random velocities of up to 0.5 m/s into each
+    // other and the walls of a closed box with gravity: the contacts, few at first, multiply.
+    const Real R = sphere_test::set_p<Real>::radius;
+    sphere::settings<Real> s = sphere_test::frictional_box<Real>(double(5 * R));
+    s.skin = Real(skin) * R;
+    s.reorder = reorder;
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> u(-0.5, 0.5);
+    std::vector<sphere::particle<Real>> p;
+    for (int k = 0; k < 4; ++k)
+        for (int j = 0; j < 4; ++j)
+            for (int i = 0; i < 4; ++i)
+                p.push_back(sphere_test::ball<Real>({Real((i - 1.5) * 2.3) * R, Real((j - 1.5) * 2.3) * R,
+                                                     Real((k - 1.5) * 2.3) * R},
+                                                    {Real(u(rng)), Real(u(rng)), Real(u(rng))}));
+    sphere::simulation<P> grows(s, p), roomy(s, p);
+    roomy.reserve_contacts(2000); // ~30 neighbours each: more than 64 spheres can have
+    const std::size_t first = grows.list_overflows();
+    for (int k = 0; k < 2000; ++k) {
+        grows.step();
+        roomy.step();
+    }
+    INFO("reorder " << reorder << ", skin " << skin << " R: entries " << grows.contact_entries() << ", overflows "
+                    << first << " -> " << grows.list_overflows() << ", rebuilds " << grows.rebuilds());
+    CHECK(grows.list_overflows() > first); // the lists did outgrow their capacity
+    CHECK(roomy.list_overflows() == first);
+    CHECK(grows.rebuilds() == roomy.rebuilds());
+    const sphere::particle_snapshot<Real> a = grows.snapshot(), b = roomy.snapshot();
+    std::size_t differ = 0;
+    for (std::size_t i = 0; i < a.size(); ++i)
+        differ += !(a.position(i) == b.position(i)) || !(a.v[i] == b.v[i]) || !(a.omega[i] == b.omega[i]);
+    CHECK(differ == 0);
+    const sphere::contact_table<Real> ca = grows.contacts(), cb = roomy.contacts();
+    REQUIRE(ca.partner == cb.partner);
+    std::size_t histories_differ = 0;
+    for (std::size_t e = 0; e < ca.history.size(); ++e)
+        histories_differ += !(ca.history[e].xyz() == cb.history[e].xyz()) || ca.history[e].w != cb.history[e].w;
+    CHECK(histories_differ == 0);
 }

@@ -779,7 +779,8 @@ TEMPLATE_TEST_CASE("every cell's start is the number of particles in lower cells
     p.x = x.data();
     p.user = user.data();
     sphere::neighbor_grid<Real, sphere::host> grid(g);
-    grid.build(p);
+    sphere::execution_context<sphere::host> context;
+    grid.build(context, p);
     const sphere::grid_view<Real> v = grid.view();
 
     std::vector<unsigned> below(g.cell_count() + 1, 0); // particles in cells lower than c

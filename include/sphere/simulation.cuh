@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cstddef>
 #include <functional>
+#include <limits>
 #include <type_traits>
 #include <utility>
 #include <vector>
@@ -67,20 +68,22 @@ struct by_rank {
 /// ranks, on the thread that summed most of their pairs and in the same parallel region
 /// (contact/interact.cuh, sum_by_slabs): their wall contacts (each wall particle's loads into
 /// `loads`, by its index in contact_lists::wall_ranks, for an ordered sum afterwards), then
-/// `body` (the integration) and, with `Check`, the particle check (the thread's largest result
-/// into moved[thread]).
-template <class P, class Walls, class Body, bool Check>
+/// `body` (the integration) and the particle check `Check` (check_particle, or
+/// check_after_drift for an integrator that drifts first; the thread's largest result into
+/// moved[thread]).
+template <class P, class Walls, class Body, class Check>
 struct finish_block {
     using Real = real_t<P>;
     using Coord = coord_t<P>;
     Walls walls;
     Body body;
-    check_particle<P> check;
+    Check check;
     contact_view<Real> c;
     const unsigned* wall_ranks; ///< host memory
     std::size_t wall_count;
     wall_loads* loads;
     Coord* moved;
+    const unsigned* halt; ///< `body` is not run when *halt (see unless_halted)
 
     void operator()(unsigned first, unsigned end, int thread) const
     {
@@ -88,33 +91,48 @@ struct finish_block {
         const unsigned* hi = std::lower_bound(lo, wall_ranks + wall_count, end);
         for (const unsigned* k = lo; k < hi; ++k) loads[k - wall_ranks] = walls(std::size_t(k - wall_ranks));
         Coord most = 0;
+        if (*halt) end = first;
         for (unsigned begin = first; begin < end; begin += unsigned(host_chunk)) {
             const unsigned stop = end - begin > host_chunk ? begin + unsigned(host_chunk) : end;
-            if constexpr (Check) {
-                by_rank<then_check<Body, P>, Real> f{{body, check}, c};
-                Coord values[host_chunk];
-                SPHERE_VECTORISE_LOOP
-                for (unsigned r = begin; r < stop; ++r) values[r - begin] = f(r);
-                for (unsigned r = begin; r < stop; ++r) most = max_op{}(most, values[r - begin]);
-            } else {
-                by_rank<Body, Real> f{body, c};
-                SPHERE_VECTORISE_LOOP
-                for (unsigned r = begin; r < stop; ++r) f(r);
-            }
+            by_rank<then_check<Body, Check>, Real> f{{body, check}, c};
+            Coord values[host_chunk];
+            SPHERE_VECTORISE_LOOP
+            for (unsigned r = begin; r < stop; ++r) values[r - begin] = f(r);
+            for (unsigned r = begin; r < stop; ++r) most = max_op{}(most, values[r - begin]);
         }
-        if (Check) moved[thread] = most;
+        moved[thread] = most;
     }
 };
 
 /// What the host reads back at the end of a step, in one copy (docs/architecture.md,
 /// *Execution context*): the particles' loads on the walls (N), the particle check's largest
-/// squared displacement since the last rebuild (m^2, +infinity when a particle failed it) and
-/// the power of whatever drives the prescribed particles (W).
+/// squared displacement since the last rebuild (m^2, +infinity when a particle failed it), the
+/// power of whatever drives the prescribed particles (W) and the totals of the step's rebuild
+/// (those of the last one in a step without).
 template <class Coord>
 struct step_report {
     wall_loads loads;
     Coord moved2;
     double drive_power;
+    list_totals lists;
+};
+
+/// Runs `body` unless *halt: a rebuild in this step overflowed the lists' capacities, and the
+/// step runs again once they have grown, so nothing that lasts may change. A body that
+/// returns a value returns zero instead.
+template <class Body>
+struct unless_halted {
+    Body body;
+    const unsigned* halt;
+    SPHERE_HDI auto operator()(std::size_t i) const
+    {
+        using R = decltype(body(i));
+        if constexpr (std::is_void_v<R>) {
+            if (!*halt) body(i);
+        } else {
+            return *halt ? R(0) : body(i);
+        }
+    }
 };
 
 /// Runs two particle kernels on particle i, one after the other.
@@ -234,6 +252,10 @@ public:
             dt_ = s.dt;
         }
         dt_ = Coord(Real(dt_)); // the kernels step velocities with dt in Real: one dt throughout
+        for (int a = 0; a < 3; ++a) {
+            const double reach = std::max(std::fabs(double(s.box.lo[a])), std::fabs(double(s.box.hi[a])));
+            drift_margin_ = std::max(drift_margin_, 16 * double(std::numeric_limits<Coord>::epsilon()) * reach);
+        }
 
         particles_ = particle_state<Precision, Policy>(particles, Integrator::distinct_synchronous_velocity,
                                                        s.energy_audit, s.angular_position);
@@ -249,7 +271,13 @@ public:
         summation_ = interaction<Precision, Policy>::resolve(s.pair_summation);
         x_at_build_.resize(n);
         report_.resize(1);
-        rebuild_lists();
+        // The first build learns the lists' capacities (each overflow grows them).
+        detail::step_report<Coord>* report = report_.data();
+        for (list_totals t{};;) {
+            rebuild_lists(&report->lists);
+            context_.read_back(&t, &report->lists, 1, "the contact lists' totals", 0);
+            if (settle_rebuild(t)) break;
+        }
         // An integrator that kicks before the forces needs the forces of the start.
         if (Integrator::drifts_before_forces)
             settings_.contact_forces ? initial_forces<true>() : initial_forces<false>();
@@ -290,6 +318,7 @@ public:
         const std::size_t slot = static_cast<std::size_t>(std::find(user.begin(), user.end(), unsigned(i)) - user.begin());
         for_each_index(Policy{}, 1,
                        detail::set_kinematics<Precision>{particles_.view(), slot, vec_cast<Real>(v), vec_cast<Real>(omega)});
+        drift_checked_ = false;
     }
 
     /// Changes how wall face f moves from the next step on (e.g. from consolidation at a
@@ -350,8 +379,15 @@ public:
     particle_snapshot<Coord> snapshot() const { return particles_.snapshot(); }
     /// A host copy of the contact lists, in user order (forces only with settings.contact_forces).
     contact_table<Coord> contacts() const { return lists_.table(particles_.user_indices()); }
-    /// Entries in the contact lists (pairs from both sides, and wall entries).
+    /// Entries in the contact lists (each pair once, and each particle's wall entries).
     std::size_t contact_entries() const { return lists_.entries(); }
+    /// Makes room in the contact lists for `entries` entries (as contact_entries() counts them)
+    /// and as many carried histories, so that rebuilds up to that size neither allocate nor run
+    /// a step twice. Without it the lists grow by themselves (see list_overflows()).
+    void reserve_contacts(std::size_t entries) { lists_.reserve(entries, entries); }
+    /// How many rebuilds found the lists too small, grew them and ran again (the first build's
+    /// included): a step that does so reads back twice and allocates.
+    std::size_t list_overflows() const { return lists_.overflows(); }
 
     /// Kernel view of the particle fields (policy memory, storage order: `user` names each
     /// slot's particle), for couplings that read positions and velocities between steps (the
@@ -365,6 +401,7 @@ public:
     /// not part of energy().boundary_work (the coupling books it: work_on_particles()).
     vec3<Real>* external_forces()
     {
+        drift_checked_ = false; // the caller may write them: the next drift checks its own positions
         if (external_.size() != size()) external_ = buffer<vec3<Real>, Policy>(size(), vec3<Real>{0, 0, 0});
         return external_.data();
     }
@@ -448,7 +485,7 @@ public:
         at_build.n = size();
         at_build.x = x_build.data();
         at_build.user = users.data();
-        grid_.build(at_build, x_at_build_.data()); // set below
+        grid_.build(context_, at_build, x_at_build_.data()); // set below
         const grid_view<Coord> g = grid_.view();
         const std::vector<unsigned> before = particles_.user_indices();
         std::vector<unsigned> storage = identity;
@@ -465,6 +502,10 @@ public:
         particles_.restore(restored);
         lists_.restore(s.contacts, g, !settings_.reorder);
         interaction_.lists_changed();
+        wall_launch_ = lists_.wall_particles();
+        detail::step_report<Coord> fresh{};
+        fresh.lists = {0, unsigned(lists_.entries()), unsigned(wall_launch_), 0};
+        report_.assign(std::vector<detail::step_report<Coord>>{fresh});
         std::vector<vec4<Coord>> slots(size());
         for (std::size_t k = 0; k < size(); ++k) slots[k] = s.x_at_build[storage[k]];
         x_at_build_.assign(slots);
@@ -482,6 +523,7 @@ public:
         rebuilds_ = s.rebuilds;
         needs_rebuild_ = s.needs_rebuild;
         time_ = static_cast<double>(steps_) * static_cast<double>(dt_);
+        drift_checked_ = false;
     }
 
     /// Total linear momentum, sum m v (kg m/s), summed in rank order.
@@ -495,15 +537,17 @@ public:
 
 private:
     /// Hashes the particles into the grid, builds the new lists (carrying the history over by
-    /// user index) and permutes every per-particle array into the grid's cell order.
-    void rebuild_lists()
+    /// user index) and permutes every per-particle array into the grid's cell order, without
+    /// waiting for the device: the lists' totals go to `totals` (policy memory), and
+    /// settle_rebuild() takes them once read back.
+    void rebuild_lists(list_totals* totals)
     {
         // The positions of this rebuild in rank order go straight into x_at_build_: the lists
         // are built from them, and once the particles are stored in rank order they are the
         // positions at the rebuild of each slot.
-        grid_.build(particles_.view(), x_at_build_.data());
+        grid_.build(context_, particles_.view(), x_at_build_.data());
         const grid_view<Coord> g = grid_.view();
-        lists_.rebuild(g, walls_, settings_.skin, !settings_.reorder);
+        lists_.rebuild(context_, g, walls_, settings_.skin, !settings_.reorder, totals);
         interaction_.lists_changed();
         if (settings_.reorder) {
             particles_.permute(g.order, x_at_build_.data(), external_);
@@ -511,9 +555,23 @@ private:
             const particle_view<Precision> p = particles_.view();
             for_each_index(Policy{}, p.n, detail::copy_back<vec4<Coord>>{p.x, x_at_build_.data()});
         }
+        wall_launch_ = size(); // the wall particles are known once the totals are read back
+    }
+
+    /// Takes the totals of rebuild_lists(), read back: true when the lists are complete, false
+    /// when they overflowed their capacities, which have now grown, and the particles are back
+    /// in their slots, for the rebuild to run again.
+    bool settle_rebuild(const list_totals& t)
+    {
+        if (!lists_.settle(t)) {
+            if (settings_.reorder) particles_.unpermute(grid_.view().order, x_at_build_.data(), external_);
+            return false;
+        }
+        wall_launch_ = t.wall_particles;
         walls_at_build_ = walls_;
         ++rebuilds_;
         needs_rebuild_ = false;
+        return true;
     }
 
     /// One step; `External`: the particles have external forces.
@@ -540,79 +598,105 @@ private:
         constexpr bool drifted = Integrator::drifts_before_forces;
         const detail::integrate_particles<Precision, Integrator, External> integrate{p, settings_.box, gravity_,
                                                                                    Real(dt_), external};
+        const detail::drift_particles<Precision, Integrator, External> drift{p, settings_.box, gravity_, Real(dt_),
+                                                                            external};
         detail::step_report<Coord>* report = report_.data(); // policy memory
+        const unsigned* halt = &report->lists.overflow;
         if constexpr (drifted) {
-            checked_into(detail::drift_particles<Precision, Integrator, External>{p, settings_.box, gravity_, Real(dt_),
-                                                                                 external},
-                         &report->moved2);
-            Coord moved2 = 0;
-            context_.read_back(&moved2, &report->moved2, 1, "the particle check after the drift", steps_ + 1);
-            judge(moved2, steps_ + 1);
-            turn();
+            // The last step's report checked the positions this drift gives (check_after_drift),
+            // unless the host has changed something the drift reads since: then the drift
+            // checks them itself, and the host waits for that check before deciding on a rebuild.
+            if (drift_checked_) {
+                for_each_index(Policy{}, n, drift);
+            } else {
+                checked_into(drift, check(), &report->moved2);
+                Coord moved2 = 0;
+                context_.read_back(&moved2, &report->moved2, 1, "the particle check after the drift", steps_ + 1);
+                judge(moved2, steps_ + 1, drift_margin_); // the margin as below: a restart decides alike
+            }
+            turn(halt);
         }
-        if (needs_rebuild_) rebuild_lists();
-        if constexpr (Book) {
-            const detail::both<detail::finish_audit<Precision>, decltype(integrate)> body{{p, Real(dt_)}, integrate};
-            finish_step<Book, Record>(body, report);
-        } else {
-            finish_step<Book, Record>(integrate, report);
-        }
-        if constexpr (!drifted) turn();
-        if (drive_)
-            transform_reduce_into(context_, n,
-                                  detail::by_rank<detail::drive_power<Precision>, Real>{{p, gravity_}, lists_.view()},
-                                  0.0, plus_op{}, &report->drive_power);
+        // From here the step may run twice: when its rebuild overflows the lists' capacities,
+        // nothing that lasts changes (the bodies see *halt), the capacities grow and it runs
+        // again, to the same bits as with room from the start.
+        const bool rebuild = needs_rebuild_;
         detail::step_report<Coord> done{};
-        context_.read_back(&done, report, 1, "the step's report (wall loads, particle check, drive power)",
-                           steps_ + 1);
+        do {
+            if (rebuild) rebuild_lists(&report->lists);
+            // the check at the end: of where the particles are, or of where the next drift puts them
+            const auto checks = [&] {
+                if constexpr (drifted) return detail::check_after_drift<Precision, Integrator, External>{drift, check()};
+                else return check();
+            }();
+            if constexpr (Book) {
+                const detail::both<detail::finish_audit<Precision>, decltype(integrate)> body{{p, Real(dt_)}, integrate};
+                finish_step<Book, Record>(body, checks, report);
+            } else {
+                finish_step<Book, Record>(integrate, checks, report);
+            }
+            if constexpr (!drifted) turn(halt);
+            if (drive_)
+                transform_reduce_into(context_, n,
+                                      detail::by_rank<detail::drive_power<Precision>, Real>{{p, gravity_}, lists_.view()},
+                                      0.0, plus_op{}, &report->drive_power);
+            context_.read_back(&done, report, 1,
+                               "the step's report (wall loads, particle check, drive power, list totals)", steps_ + 1);
+        } while (rebuild && !settle_rebuild(done.lists));
         advance_walls(walls_, settings_.walls, settings_.box, done.loads.force, time_, dt_, steps_ + 1);
         if (drive_) drive_work_ += done.drive_power * double(dt_);
         ++steps_;
         time_ = static_cast<double>(steps_) * static_cast<double>(dt_);
-        if constexpr (!drifted) judge(done.moved2, steps_);
+        if constexpr (drifted) {
+            // A bad particle after the next drift is left for that drift's own check to name;
+            // a margin covers the rounding by which the drift may differ from the check's
+            // copy of it (nvcc may contract them into different FMAs).
+            drift_checked_ = std::isfinite(done.moved2);
+            if (drift_checked_) judge(done.moved2, steps_ + 1, drift_margin_);
+        } else {
+            judge(done.moved2, steps_);
+        }
         for (const auto& o : observers_)
             if (steps_ % o.first == 0) o.second(*this);
     }
 
-    /// The pair sums, the walls and `body` (the integration after the forces), with the
-    /// particle check when the integrator moves the particles after the forces: in one parallel
-    /// region on the host's slab schedule, else pass after pass. Leaves the wall loads and the
-    /// check's largest squared displacement in `report` (policy memory).
-    template <bool Book, bool Record, class Body>
-    void finish_step(const Body& body, detail::step_report<Coord>* report)
+    /// The pair sums, the walls, `body` (the integration after the forces) and the particle
+    /// check `checks`: in one parallel region on the host's slab schedule, else pass after
+    /// pass. Leaves the wall loads and the check's largest squared displacement in `report`
+    /// (policy memory).
+    template <bool Book, bool Record, class Body, class Check>
+    void finish_step(const Body& body, const Check& checks, detail::step_report<Coord>* report)
     {
-        constexpr bool check_here = !Integrator::drifts_before_forces;
         const auto walls = wall_contacts<Book, Record>(true);
-        if constexpr (runs_in_blocks<Policy>) { // report is host memory
-            const std::size_t count = lists_.wall_particles();
+        const unsigned* halt = &report->lists.overflow;
+        if constexpr (runs_in_blocks<Policy>) { // report is host memory, read in place
+            const std::size_t count = report->lists.wall_particles;
             wall_loads_.assign(count, detail::wall_loads{{0, 0, 0, 0, 0, 0}});
             std::vector<Coord> moved(std::size_t(host_threads()), Coord(0));
-            const detail::finish_block<Precision, decltype(walls), Body, check_here> finish{
-                walls, body, check(), lists_.view(), lists_.wall_ranks(), count, wall_loads_.data(), moved.data()};
-            if (interaction_.template sum_pairs<Book, Record>(pair_contact(), lists_, summation_, true, finish)) {
+            const detail::finish_block<Precision, decltype(walls), Body, Check> finish{
+                walls, body, checks, lists_.view(), lists_.wall_ranks(), count, wall_loads_.data(), moved.data(), halt};
+            if (interaction_.template sum_pairs<Book, Record>(context_, pair_contact(), lists_, summation_, true, finish)) {
                 report->loads = detail::wall_loads{{0, 0, 0, 0, 0, 0}};
                 for (const detail::wall_loads& l : wall_loads_) report->loads = report->loads + l;
-                if constexpr (check_here) {
-                    report->moved2 = 0;
-                    for (Coord m : moved) report->moved2 = max_op{}(report->moved2, m);
-                }
+                report->moved2 = 0;
+                for (Coord m : moved) report->moved2 = max_op{}(report->moved2, m);
                 return;
             }
         } else {
-            interaction_.template sum_pairs<Book, Record>(pair_contact(), lists_, summation_, true);
+            interaction_.template sum_pairs<Book, Record>(context_, pair_contact(), lists_, summation_, true);
         }
-        transform_reduce_into(context_, lists_.wall_particles(), walls, detail::wall_loads{{0, 0, 0, 0, 0, 0}},
-                              plus_op{}, &report->loads);
-        if constexpr (check_here) checked_into(body, &report->moved2);
-        else for_each_index(Policy{}, particles_.size(), body);
+        transform_reduce_into(context_, wall_launch_, walls, detail::wall_loads{{0, 0, 0, 0, 0, 0}}, plus_op{},
+                              &report->loads);
+        checked_into(detail::unless_halted<Body>{body, halt}, checks, &report->moved2);
     }
 
     /// Advances the angular positions (settings.angular_position) with the angular velocities
-    /// the step has just set.
-    void turn()
+    /// the step has just set, unless *halt (policy memory; detail::unless_halted).
+    void turn(const unsigned* halt)
     {
         const particle_view<Precision> p = particles_.view();
-        if (p.angpos) for_each_index(Policy{}, p.n, detail::turn_particles<Precision>{p, Real(dt_)});
+        if (p.angpos)
+            for_each_index(Policy{}, p.n,
+                           detail::unless_halted<detail::turn_particles<Precision>>{{p, Real(dt_)}, halt});
     }
 
     /// The forces of the current positions, leaving the contacts' histories and the energy
@@ -620,8 +704,8 @@ private:
     template <bool Record>
     void initial_forces()
     {
-        interaction_.template sum_pairs<false, Record>(pair_contact(), lists_, summation_, false);
-        transform_reduce_into(context_, lists_.wall_particles(), wall_contacts<false, Record>(false),
+        interaction_.template sum_pairs<false, Record>(context_, pair_contact(), lists_, summation_, false);
+        transform_reduce_into(context_, wall_launch_, wall_contacts<false, Record>(false),
                               detail::wall_loads{{0, 0, 0, 0, 0, 0}}, plus_op{}, &report_.data()->loads);
     }
 
@@ -638,16 +722,15 @@ private:
         return {particles_.view(), lists_.view(), lists_.wall_ranks(), walls_, wall_params_, Real(dt_), update_history};
     }
 
-    /// Runs the particle kernel `body` on every particle and checks each one after it, in one
-    /// pass (a particle outside the walls, non-finite values, the largest displacement since
-    /// the lists were built); leaves the largest squared displacement, +infinity when a
+    /// Runs the particle kernel `body` on every particle and checks each one after it with
+    /// `checks`, in one pass (a particle outside the walls, non-finite values, the largest
+    /// displacement since the lists were built); leaves the largest squared displacement, +infinity when a
     /// particle failed the check, in `moved2` (policy memory).
-    template <class Body>
-    void checked_into(const Body& body, Coord* moved2)
+    template <class Body, class Check>
+    void checked_into(const Body& body, const Check& checks, Coord* moved2)
     {
-        const particle_view<Precision> p = particles_.view();
-        transform_reduce_into(context_, p.n, detail::then_check<Body, Precision>{body, check()}, Coord(0), max_op{},
-                              moved2);
+        transform_reduce_into(context_, particles_.size(), detail::then_check<Body, Check>{body, checks}, Coord(0),
+                              max_op{}, moved2);
     }
 
     detail::check_particle<Precision> check()
@@ -658,14 +741,14 @@ private:
     /// Acts on the particle check of step `step` (the largest squared displacement): a
     /// sphere::error naming the step and the particle (the lowest user index) when one failed
     /// it; marks the lists for a rebuild when a particle and a wall may have come closer than
-    /// the skin.
-    void judge(Coord moved2, std::size_t step)
+    /// the skin, with each displacement taken `margin` (m) longer.
+    void judge(Coord moved2, std::size_t step, double margin = 0)
     {
         if (!std::isfinite(moved2))
             report_bad_particle(transform_reduce(Policy{}, size(), detail::bad_particle<Precision>{check()},
                                                  ~std::size_t(0), min_op{}),
                                 step);
-        const double moved = std::sqrt(double(moved2)), skin = double(settings_.skin);
+        const double moved = std::sqrt(double(moved2)) + margin, skin = double(settings_.skin);
         bool rebuild = 2 * moved > skin;
         for (int f = 0; f < wall_set<Coord>::count; ++f)
             if (walls_.face[f].active && std::fabs(walls_.face[f].position - walls_at_build_.face[f].position) + moved > skin)
@@ -739,6 +822,12 @@ private:
     bool drive_ = false;                  ///< some particle is prescribed: book the drive's work
     buffer<vec3<Real>, Policy> external_; ///< external forces (empty until external_forces() is called)
     std::vector<detail::wall_loads> wall_loads_; ///< each wall particle's loads of the step (host)
+    std::size_t wall_launch_ = 0;
+    /// Velocity Verlet: the last step's report holds the check of the positions the next drift
+    /// gives (false at the start and after the host changed what the drift reads), and the
+    /// margin (m) that covers the rounding between the two (16 ulp of the largest coordinate).
+    bool drift_checked_ = false;
+    double drift_margin_ = 0; ///< wall contact threads: the wall particles, or all after a rebuild not yet read back
     std::vector<motion> kinds_; ///< host copy of each particle's motion (it never changes)
     std::vector<std::pair<std::size_t, observer>> observers_;
     thread_governor governor_; ///< all threads or one, whichever is faster on this machine now

@@ -30,7 +30,10 @@
 #include "../core/vec.cuh"
 #include "../exec/algorithms.cuh"
 #include "../exec/buffer.cuh"
+#include "../exec/collectives.cuh"
+#include "../exec/context.cuh"
 #include "../exec/for_each.cuh"
+#include "../exec/policy.cuh"
 #include "../grid/neighbor_grid.cuh"
 
 namespace sphere {
@@ -38,6 +41,21 @@ namespace sphere {
 /// Partner codes from here up name a wall face: wall_partner_base + f. Particle indices stay
 /// below it.
 inline constexpr unsigned wall_partner_base = 0xFFFFFFF0u;
+
+/// The value of contact_lists::wall_ranks() past the ranks that have wall entries.
+inline constexpr unsigned no_rank = 0xFFFFFFFFu;
+
+/// What a rebuild found, in the policy's memory (read back with the step's report): the
+/// entries whose history it carried over, the entries of the new lists, the particles with
+/// wall entries, and whether the first two exceeded the capacities the lists had. After an
+/// overflow the new lists are empty and contact_lists::settle grows them for the rebuild to
+/// run again.
+struct list_totals {
+    unsigned kept = 0;
+    unsigned entries = 0;
+    unsigned wall_particles = 0;
+    unsigned overflow = 0;
+};
 
 /// A contact's history or recorded force as seen from its other particle: the tangential part
 /// (xyz: displacement or force) reversed, w (sliding flag, or f_n . n) kept.
@@ -85,6 +103,12 @@ public:
 
     std::size_t size() const { return shift_.size(); }
     history_view<Real> view() { return {shift_.data(), sliding_.data()}; }
+    /// n entries; those already there keep their values.
+    void resize(std::size_t n)
+    {
+        shift_.resize(n, vec3<Real>{0, 0, 0});
+        sliding_.resize(n, std::uint8_t(0));
+    }
     void swap(history_store& other) noexcept
     {
         shift_.swap(other.shift_);
@@ -273,20 +297,19 @@ struct fill_visit {
     SPHERE_HD void wall(int f) { key[found++] = wall_partner_base + unsigned(f); }
 };
 
-/// The old lists, for carrying histories over: rows by old rank, partners as old slots.
+/// The histories carried over from the old lists (contact_lists' kept entries): rows by the
+/// particles' old slots, partners as old slots or wall codes.
 template <class Real>
 struct old_lists {
     const unsigned* offset;
     const unsigned* partner;
     history_view<Real> history;
-    const unsigned* rank_of_slot; ///< null when old ranks and slots coincide
 
     /// The history of the entry of old slot `owner` for `code` (an old slot or a wall code);
     /// false when there is none.
     SPHERE_HD bool find(unsigned owner, unsigned code, vec4<Real>& h) const
     {
-        const unsigned r = rank_of_slot ? rank_of_slot[owner] : owner;
-        for (unsigned m = offset[r]; m < offset[r + 1]; ++m)
+        for (unsigned m = offset[owner]; m < offset[owner + 1]; ++m)
             if (partner[m] == code) {
                 h = history.load(m);
                 return true;
@@ -306,9 +329,11 @@ struct fill_entries {
     history_view<Real> history;
     old_lists<Real> old;
     bool keep_order;
+    const list_totals* totals; ///< nothing is written when the lists overflowed
 
     SPHERE_HD void operator()(std::size_t k) const
     {
+        if (totals->overflow) return;
         const unsigned begin = offset[k], n = offset[k + 1] - begin;
         unsigned* p = partner + begin;
         fill_visit v{p};
@@ -338,36 +363,36 @@ struct fill_entries {
     }
 };
 
-/// How many entries of row r have a non-zero history.
+/// How many entries of row r have a non-zero history, counted at the row's particle's slot.
 template <class Real>
 struct count_histories {
-    const unsigned* offset;
-    history_view<Real> history;
+    contact_view<Real> c;
     unsigned* count;
     SPHERE_HD void operator()(std::size_t r) const
     {
-        unsigned c = 0;
-        for (unsigned e = offset[r]; e < offset[r + 1]; ++e) c += has_history(history.load(e));
-        count[r] = c;
+        unsigned kept = 0;
+        for (unsigned e = c.offset[r]; e < c.offset[r + 1]; ++e) kept += has_history(c.history.load(e));
+        count[c.slot(r)] = kept;
     }
 };
 
-/// Copies the entries of row r with a non-zero history to its place in smaller lists.
+/// Copies the entries of row r with a non-zero history to the kept entries, in a row by the
+/// particle's slot; nothing when they do not fit `capacity` (to_offset[n] is their total).
 template <class Real>
 struct copy_histories {
-    const unsigned* offset;
-    const unsigned* partner;
-    history_view<Real> history;
+    contact_view<Real> c;
     const unsigned* to_offset;
+    std::size_t capacity;
     unsigned* to_partner;
     history_view<Real> to_history;
     SPHERE_HD void operator()(std::size_t r) const
     {
-        unsigned k = to_offset[r];
-        for (unsigned e = offset[r]; e < offset[r + 1]; ++e) {
-            const vec4<Real> h = history.load(e);
+        if (to_offset[c.n] > capacity) return;
+        unsigned k = to_offset[c.slot(r)];
+        for (unsigned e = c.offset[r]; e < c.offset[r + 1]; ++e) {
+            const vec4<Real> h = c.history.load(e);
             if (has_history(h)) {
-                to_partner[k] = partner[e];
+                to_partner[k] = c.partner[e];
                 to_history.store(k, h);
                 ++k;
             }
@@ -375,20 +400,37 @@ struct copy_histories {
     }
 };
 
+/// Writes the totals of a rebuild from its scans (kept entries, new entries) and whether they
+/// exceed the capacities.
+struct record_totals {
+    const unsigned* kept_offset;
+    const unsigned* offset;
+    std::size_t n, kept_capacity, entry_capacity;
+    list_totals* totals;
+    SPHERE_HD void operator()(std::size_t) const
+    {
+        totals->kept = kept_offset[n];
+        totals->entries = offset[n];
+        totals->wall_particles = 0;
+        totals->overflow = kept_offset[n] > kept_capacity || offset[n] > entry_capacity;
+    }
+};
+
 /// Whether rank r has wall entries (1 or 0), for the list of such ranks.
 struct has_walls {
     const unsigned* offset;
     const unsigned* partner;
+    const list_totals* totals;
     unsigned* flag;
     SPHERE_HD void operator()(std::size_t r) const
     {
         const unsigned end = offset[r + 1];
-        flag[r] = end > offset[r] && partner[end - 1] >= wall_partner_base ? 1u : 0u;
+        flag[r] = !totals->overflow && end > offset[r] && partner[end - 1] >= wall_partner_base ? 1u : 0u;
     }
 };
 
 /// Writes rank r at its place in the list of ranks with wall entries (`place`: the exclusive
-/// scan of has_walls' flags).
+/// scan of has_walls' flags; the list is filled with no_rank beforehand).
 struct list_wall_ranks {
     const unsigned* place;
     unsigned* ranks;
@@ -398,14 +440,39 @@ struct list_wall_ranks {
     }
 };
 
-/// Inverse of a permutation: inverse[order[k]] = k.
-struct invert_permutation {
+/// The number of ranks with wall entries, into the totals.
+struct record_wall_particles {
+    const unsigned* place;
+    std::size_t n;
+    list_totals* totals;
+    SPHERE_HD void operator()(std::size_t) const { totals->wall_particles = place[n]; }
+};
+
+/// Empties every row of lists that overflowed, so that nothing reads past their arrays.
+struct empty_if_overflow {
+    unsigned* offset;
+    const list_totals* totals;
+    SPHERE_HD void operator()(std::size_t r) const
+    {
+        if (totals->overflow) offset[r] = 0;
+    }
+};
+
+/// The storage slot of each rank and its inverse (lists that keep the particles' order), unless
+/// the lists overflowed (the old ones stay in use).
+struct set_rank_slots {
     const unsigned* order;
-    unsigned* inverse;
-    SPHERE_HD void operator()(std::size_t k) const { inverse[order[k]] = static_cast<unsigned>(k); }
+    const list_totals* totals;
+    unsigned* slot_of_rank;
+    unsigned* rank_of_slot;
+    SPHERE_HD void operator()(std::size_t k) const
+    {
+        if (totals->overflow) return;
+        slot_of_rank[k] = order[k];
+        rank_of_slot[order[k]] = static_cast<unsigned>(k);
+    }
 };
 } // namespace detail
-
 /// The contact lists of particles in precision P (core/precision.cuh): the neighbour search in
 /// coord_t<P> (the positions' type), histories and forces in real_t<P>; host tables in coord_t<P>.
 template <class P, class Policy>
@@ -416,59 +483,108 @@ public:
 
     contact_lists() = default;
     /// Empty lists for n particles; `record_forces` keeps each entry's force of the last step.
-    contact_lists(std::size_t n, bool record_forces) : record_forces_(record_forces), offset_(n + 1, 0u) {}
+    contact_lists(std::size_t n, bool record_forces)
+        : record_forces_(record_forces), offset_(n + 1, 0u), next_offset_(n + 1, 0u), kept_offset_(n + 1, 0u),
+          wall_ranks_(n, no_rank)
+    {
+    }
 
     std::size_t size() const { return offset_.size() - 1; }
-    /// Entries in all lists: each pair once, and each particle's walls within reach.
+    /// Entries in all lists: each pair once, and each particle's walls within reach (host
+    /// copy, from the last settled rebuild).
     std::size_t entries() const { return entries_; }
+    /// How many entries the lists' arrays hold (at least entries()).
+    std::size_t capacity() const { return partner_.size(); }
+    /// How many rebuilds overflowed the capacities and ran again.
+    std::size_t overflows() const { return overflows_; }
     bool records_forces() const { return record_forces_; }
     /// The first rank of each layer of the grid along its slow axis, and one past the last
-    /// (host copy, from the last rebuild).
+    /// (host copy, from the last rebuild; for the host's slab schedule only).
     const std::vector<unsigned>& layer_start() const { return layer_start_; }
     /// Whether the slow axis of the grid of the last rebuild is periodic.
     bool periodic_layers() const { return periodic_layers_; }
     /// Entries of ranks [0, r) for each r of layer_start() (host copy, from the last rebuild).
     const std::vector<unsigned>& layer_entries() const { return layer_entries_; }
-    /// The ranks that have wall entries, ascending (policy memory), and how many.
+    /// The ranks that have wall entries, ascending, then no_rank up to size() (policy memory).
     const unsigned* wall_ranks() const { return wall_ranks_.data(); }
+    /// How many ranks have wall entries (host copy, from the last settled rebuild).
     std::size_t wall_particles() const { return wall_particles_; }
 
-    /// Rebuilds every list from a grid built over the particles in their current slots. The
-    /// new lists are in the grid's order (its ranks); partners are stored as ranks, to be the
-    /// slots once the caller permutes the particles into that order, or, with `keep_order`,
-    /// as the current slots, which the particles keep. Walls within r + skin are listed too.
-    void rebuild(const grid_view<Coord>& grid, const wall_set<Coord>& walls, Coord skin, bool keep_order)
+    /// Rebuilds every list from a grid built over the particles in their current slots,
+    /// without waiting for the device: its totals go to `totals` (policy memory), for the
+    /// caller to read back and hand to settle(). The new lists are in the grid's order (its
+    /// ranks); partners are stored as ranks, to be the slots once the caller permutes the
+    /// particles into that order, or, with `keep_order`, as the current slots, which the
+    /// particles keep. Walls within r + skin are listed too. When the histories to carry over
+    /// or the new entries exceed the capacities, the new lists are empty and the old ones (or
+    /// their histories) stay for the rebuild to run again after settle().
+    void rebuild(execution_context<Policy>& ctx, const grid_view<Coord>& grid, const wall_set<Coord>& walls, Coord skin,
+                 bool keep_order, list_totals* totals)
     {
         const std::size_t n = size();
-        keep_histories_only(); // the old lists shrink to what the new ones can inherit
+        if (!histories_kept_) keep_histories(ctx);
+        histories_kept_ = true;
         const detail::neighbour_scan<Coord> scan{grid, walls, skin};
-        buffer<unsigned, Policy> offset(n + 1, 0u);
-        for_each_index(Policy{}, n, detail::count_entries<Coord>{scan, offset.data()});
-        const std::size_t total = exclusive_scan_in_place(Policy{}, offset.data(), n + 1);
-        if (total >= std::size_t(std::numeric_limits<unsigned>::max()))
-            detail::fail("contact lists: ", total, " entries within r_i + r_j + skin, more than 2^32 - 1; reduce the skin");
-        buffer<unsigned, Policy> partner(total);
-        history_store<Real, Policy> history(total);
-        const detail::old_lists<Real> old{offset_.data(), partner_.data(), history_.view(),
-                                          keep_order_ ? rank_of_slot_.data() : nullptr};
+        unsigned* offset = next_offset_.data();
+        for_each_index(Policy{}, n, detail::count_entries<Coord>{scan, offset});
+        for_each_index(Policy{}, 1, detail::fill_value<unsigned>{offset + n, 0u});
+        exclusive_scan(ctx, offset, n + 1);
+        for_each_index(Policy{}, 1,
+                       detail::record_totals{kept_offset_.data(), offset, n, kept_capacity(), capacity(), totals});
+        const detail::old_lists<Real> old{kept_offset_.data(), kept_partner_.data(), kept_history_.view()};
         for_each_index(Policy{}, n,
-                       detail::fill_entries<Coord, Real>{scan, offset.data(), partner.data(), history.view(), old,
-                                                         keep_order});
-        offset_.swap(offset);
-        partner_.swap(partner);
-        history_.swap(history);
-        entries_ = total;
-        if (record_forces_) force_ = buffer<vec4<Real>, Policy>(total, vec4<Real>{0, 0, 0, 0});
-        else force_ = buffer<vec4<Real>, Policy>();
+                       detail::fill_entries<Coord, Real>{scan, offset, partner_.data(), history_.view(), old, keep_order,
+                                                         totals});
+        if (record_forces_) for_each_index(Policy{}, capacity(), detail::fill_value<vec4<Real>>{force_.data(), {0, 0, 0, 0}});
+        set_wall_ranks(ctx, offset, totals);
+        for_each_index(Policy{}, n + 1, detail::empty_if_overflow{offset, totals});
         if (keep_order) {
-            slot_of_rank_.resize(n);
-            rank_of_slot_.resize(n);
-            for_each_index(Policy{}, n, detail::copy_back<unsigned>{grid.order, slot_of_rank_.data()});
-            for_each_index(Policy{}, n, detail::invert_permutation{grid.order, rank_of_slot_.data()});
+            if (slot_of_rank_.size() != n) {
+                slot_of_rank_.resize(n);
+                rank_of_slot_.resize(n);
+            }
+            for_each_index(Policy{}, n,
+                           detail::set_rank_slots{grid.order, totals, slot_of_rank_.data(), rank_of_slot_.data()});
         }
+        offset_.swap(next_offset_);
         keep_order_ = keep_order;
-        set_layers(grid);
-        set_wall_ranks();
+        if constexpr (runs_in_blocks<Policy>) set_layers(grid);
+    }
+
+    /// Makes room for at least `entries` entries and `kept` carried histories, so that
+    /// rebuilds up to those sizes neither allocate nor overflow.
+    void reserve(std::size_t entries, std::size_t kept)
+    {
+        if (entries > capacity()) {
+            partner_.resize(entries);
+            history_.resize(entries);
+            if (record_forces_) force_.resize(entries);
+        }
+        if (kept > kept_capacity()) {
+            kept_partner_.resize(kept);
+            kept_history_.resize(kept);
+        }
+    }
+
+    /// Takes the totals of the last rebuild, read back. Returns true when its lists are
+    /// complete. After an overflow it grows the capacities (a quarter above what the rebuild
+    /// needed), puts the old lists back in use when their histories did not fit, and returns
+    /// false: the caller puts the particles back where they were and rebuilds again.
+    bool settle(const list_totals& t)
+    {
+        if (!t.overflow) {
+            entries_ = t.entries;
+            wall_particles_ = t.wall_particles;
+            histories_kept_ = false;
+            return true;
+        }
+        ++overflows_;
+        if (t.kept > kept_capacity()) {
+            offset_.swap(next_offset_); // the old lists are whole: their histories were not copied
+            histories_kept_ = false;
+        }
+        reserve(t.entries > capacity() ? with_headroom(t.entries) : 0, t.kept > kept_capacity() ? with_headroom(t.kept) : 0);
+        return false;
     }
 
     contact_view<Real> view()
@@ -588,42 +704,72 @@ public:
             }
             off[r + 1] = static_cast<unsigned>(part.size());
         }
+        std::vector<unsigned> wall_ranks(n, no_rank);
+        std::size_t with_walls = 0;
+        for (std::size_t r = 0; r < n; ++r)
+            if (off[r + 1] > off[r] && part[off[r + 1] - 1] >= wall_partner_base) wall_ranks[with_walls++] = unsigned(r);
         offset_.assign(off);
         partner_.assign(part);
         history_.assign(hist);
+        wall_ranks_.assign(wall_ranks);
         entries_ = part.size();
+        wall_particles_ = with_walls;
+        histories_kept_ = false;
         if (record_forces_) force_.assign(std::vector<vec4<Real>>(part.size(), vec4<Real>{0, 0, 0, 0}));
         keep_order_ = keep_order;
         if (keep_order) {
             slot_of_rank_.assign(user_of_rank);
             rank_of_slot_.assign(rank_of_user);
         }
-        set_layers(grid);
-        set_wall_ranks();
+        if constexpr (runs_in_blocks<Policy>) set_layers(grid);
     }
 
 private:
-    /// Replaces the lists by the entries whose history is not zero (contacts that touched at
-    /// the last step, whose history a rebuild carries over), in the same rows, and frees the
-    /// rest before the new lists are built: the rebuild's peak memory holds the new lists and
-    /// these, not two full sets.
-    void keep_histories_only()
+    std::size_t kept_capacity() const { return kept_partner_.size(); }
+    static std::size_t with_headroom(std::size_t needed) { return needed + needed / 4 + 64; }
+
+    /// Copies the entries whose history is not zero (contacts that touched at the last step,
+    /// whose history a rebuild carries over) into the kept entries, in rows by slot.
+    void keep_histories(execution_context<Policy>& ctx)
     {
         const std::size_t n = size();
-        if (entries_ == 0) return;
-        buffer<unsigned, Policy> offset(n + 1, 0u);
-        for_each_index(Policy{}, n, detail::count_histories<Real>{offset_.data(), history_.view(), offset.data()});
-        const std::size_t kept = exclusive_scan_in_place(Policy{}, offset.data(), n + 1);
-        buffer<unsigned, Policy> partner(kept);
-        history_store<Real, Policy> history(kept);
+        const contact_view<Real> c = view();
+        for_each_index(Policy{}, n, detail::count_histories<Real>{c, kept_offset_.data()});
+        for_each_index(Policy{}, 1, detail::fill_value<unsigned>{kept_offset_.data() + n, 0u});
+        exclusive_scan(ctx, kept_offset_.data(), n + 1);
         for_each_index(Policy{}, n,
-                       detail::copy_histories<Real>{offset_.data(), partner_.data(), history_.view(), offset.data(),
-                                                    partner.data(), history.view()});
-        offset_.swap(offset);
-        partner_.swap(partner);
-        history_.swap(history);
-        force_ = buffer<vec4<Real>, Policy>();
-        entries_ = kept;
+                       detail::copy_histories<Real>{c, kept_offset_.data(), kept_capacity(), kept_partner_.data(),
+                                                    kept_history_.view()});
+    }
+
+    /// The ranks with wall entries in the new lists (rows at `offset`), and their number into
+    /// `totals`.
+    void set_wall_ranks(execution_context<Policy>& ctx, const unsigned* offset, list_totals* totals)
+    {
+        const std::size_t n = size();
+        if (wall_place_.size() != n + 1) wall_place_.resize(n + 1);
+        unsigned* place = wall_place_.data();
+        for_each_index(Policy{}, n, detail::has_walls{offset, partner_.data(), totals, place});
+        for_each_index(Policy{}, 1, detail::fill_value<unsigned>{place + n, 0u});
+        exclusive_scan(ctx, place, n + 1);
+        for_each_index(Policy{}, n, detail::fill_value<unsigned>{wall_ranks_.data(), no_rank});
+        for_each_index(Policy{}, n, detail::list_wall_ranks{place, wall_ranks_.data()});
+        for_each_index(Policy{}, 1, detail::record_wall_particles{place, n, totals});
+    }
+
+    /// The layers of the grid as ranks and entries, for the host's slab schedule (reads the
+    /// grid's cell starts and the offsets in place: host memory).
+    void set_layers(const grid_view<Coord>& grid)
+    {
+        const grid_geometry<Coord>& g = grid.geometry;
+        const std::size_t layers = g.layers(), per_layer = g.cells_per_layer();
+        layer_start_.resize(layers + 1);
+        layer_entries_.resize(layers + 1);
+        for (std::size_t l = 0; l <= layers; ++l) {
+            layer_start_[l] = grid.cell_start[l * per_layer];
+            layer_entries_[l] = offset_.data()[layer_start_[l]];
+        }
+        periodic_layers_ = g.box.periodic(g.slow);
     }
 
     /// A host copy of the first n elements of policy memory.
@@ -635,41 +781,22 @@ private:
         return b.to_host();
     }
 
-    void set_wall_ranks()
-    {
-        const std::size_t n = size();
-        buffer<unsigned, Policy> place(n + 1, 0u);
-        for_each_index(Policy{}, n, detail::has_walls{offset_.data(), partner_.data(), place.data()});
-        wall_particles_ = exclusive_scan_in_place(Policy{}, place.data(), n + 1);
-        wall_ranks_.resize(wall_particles_);
-        for_each_index(Policy{}, n,
-                       detail::list_wall_ranks{place.data(), wall_ranks_.data()});
-    }
-
-    void set_layers(const grid_view<Coord>& grid)
-    {
-        const grid_geometry<Coord>& g = grid.geometry;
-        const std::size_t layers = g.layers(), per_layer = g.cells_per_layer();
-        const std::vector<unsigned> starts = buffer_copy(grid.cell_start, g.cell_count() + 1);
-        const std::vector<unsigned> off = offset_.to_host();
-        layer_start_.resize(layers + 1);
-        layer_entries_.resize(layers + 1);
-        for (std::size_t l = 0; l <= layers; ++l) {
-            layer_start_[l] = starts[l * per_layer];
-            layer_entries_[l] = off[layer_start_[l]];
-        }
-        periodic_layers_ = g.box.periodic(g.slow);
-    }
-
     bool record_forces_ = true;
     bool keep_order_ = false;
     bool periodic_layers_ = false;
-    std::size_t entries_ = 0;
-    buffer<unsigned, Policy> offset_, partner_;
+    bool histories_kept_ = false; ///< the kept entries hold the histories of the lists in use
+    std::size_t entries_ = 0, overflows_ = 0;
+    buffer<unsigned, Policy> offset_;      ///< row r: entries [offset_[r], offset_[r + 1])
+    buffer<unsigned, Policy> next_offset_; ///< the rows a rebuild counts (then swapped with offset_)
+    buffer<unsigned, Policy> partner_;     ///< capacity() entries
     history_store<Real, Policy> history_;
     buffer<vec4<Real>, Policy> force_;
+    // The histories a rebuild carries over, in rows by slot (kept between rebuilds: their
+    // arrays only grow).
+    buffer<unsigned, Policy> kept_offset_, kept_partner_;
+    history_store<Real, Policy> kept_history_;
     buffer<unsigned, Policy> slot_of_rank_, rank_of_slot_; ///< only with keep_order
-    buffer<unsigned, Policy> wall_ranks_;
+    buffer<unsigned, Policy> wall_ranks_, wall_place_;
     std::size_t wall_particles_ = 0;
     std::vector<unsigned> layer_start_, layer_entries_;
 };

@@ -161,6 +161,7 @@ struct wall_contacts {
     SPHERE_HD wall_loads operator()(std::size_t k) const
     {
         wall_loads loads{{0, 0, 0, 0, 0, 0}};
+        if (ranks[k] == no_rank) return loads; // past the ranks with walls (a launch over all ranks)
         const std::size_t r = ranks[k], i = c.slot(r);
         const unsigned first = c.offset[r];
         const vec4<Coord> xi = p.x[i];

@@ -16,6 +16,8 @@
 #include "../core/error.cuh"
 #include "../exec/algorithms.cuh"
 #include "../exec/buffer.cuh"
+#include "../exec/collectives.cuh"
+#include "../exec/context.cuh"
 #include "../exec/for_each.cuh"
 #include "../exec/host_team.cuh"
 #include "../exec/policy.cuh"
@@ -368,7 +370,8 @@ struct gather_pair_results {
     }
 };
 
-/// The sort key of each entry for the reverse index: its partner's rank, or ~0 for a wall.
+/// The sort key of each entry for the reverse index: its partner's rank, or n for a wall and
+/// for the lists' spare capacity.
 template <class Real>
 struct reverse_keys {
     contact_view<Real> c;
@@ -377,7 +380,8 @@ struct reverse_keys {
     SPHERE_HD void operator()(std::size_t e) const
     {
         const unsigned j = c.partner[e];
-        key[e] = j < wall_partner_base ? static_cast<unsigned>(c.rank(j)) : ~0u;
+        const bool pair = e < c.offset[c.n] && j < wall_partner_base; // not a wall, nor past the entries
+        key[e] = pair ? static_cast<unsigned>(c.rank(j)) : static_cast<unsigned>(c.n);
         entry[e] = static_cast<unsigned>(e);
     }
 };
@@ -413,8 +417,8 @@ public:
     /// block of ranks (all ranks in all), in the same parallel region; returns whether it did,
     /// so that the caller runs that work otherwise.
     template <bool Book, bool Record, class Law, bool OneVelocity, class Finish = detail::no_finish>
-    bool sum_pairs(const detail::pair_contact<P, Law, OneVelocity>& eval, contact_lists<P, Policy>& lists,
-                   pair_summation how, bool update_history, const Finish& finish = {})
+    bool sum_pairs(execution_context<Policy>& ctx, const detail::pair_contact<P, Law, OneVelocity>& eval,
+                   contact_lists<P, Policy>& lists, pair_summation how, bool update_history, const Finish& finish = {})
     {
         const particle_view<P>& p = eval.p;
         const contact_view<Real> c = lists.view();
@@ -426,14 +430,15 @@ public:
             }
             return true;
         }
-        const std::size_t entries = lists.entries();
+        // sized by the lists' capacity, which the host knows without waiting for a rebuild's totals
+        const std::size_t entries = lists.capacity();
         if (force_.size() < entries) {
             force_.resize(entries);
             torque_i_.resize(entries);
             torque_j_.resize(entries);
         }
         if (Book && audit_.size() < entries) audit_.resize(entries);
-        if (!reverse_ready_) build_reverse(c, entries, p.n);
+        if (!reverse_ready_) build_reverse(ctx, c, entries, p.n);
         for_each_index(Policy{}, p.n,
                        detail::evaluate_owned_pairs<P, Law, Book, Record, OneVelocity>{
                            eval, c, force_.data(), torque_i_.data(), torque_j_.data(), Book ? audit_.data() : nullptr,
@@ -446,19 +451,21 @@ public:
     }
 
 private:
-    void build_reverse(const contact_view<Real>& c, std::size_t entries, std::size_t n)
+    void build_reverse(execution_context<Policy>& ctx, const contact_view<Real>& c, std::size_t entries, std::size_t n)
     {
-        buffer<unsigned, Policy> key(entries);
-        reverse_entry_.resize(entries);
-        reverse_offset_.resize(n + 1);
-        for_each_index(Policy{}, entries, detail::reverse_keys<Real>{c, key.data(), reverse_entry_.data()});
-        sort_by_key(Policy{}, key.data(), reverse_entry_.data(), entries);
-        find_starts(Policy{}, key.data(), entries, n, reverse_offset_.data()); // walls (key ~0) count as n
+        if (reverse_entry_.size() < entries) {
+            reverse_key_.resize(entries);
+            reverse_entry_.resize(entries);
+        }
+        if (reverse_offset_.size() != n + 1) reverse_offset_.resize(n + 1);
+        for_each_index(Policy{}, entries, detail::reverse_keys<Real>{c, reverse_key_.data(), reverse_entry_.data()});
+        sort_by_key(ctx, reverse_key_.data(), reverse_entry_.data(), entries, bits_for(n));
+        find_starts(ctx, reverse_key_.data(), 0, entries, n, reverse_offset_.data()); // key n: not a pair
         reverse_ready_ = true;
     }
 
     buffer<vec3<Real>, Policy> force_, torque_i_, torque_j_, audit_;
-    buffer<unsigned, Policy> reverse_offset_, reverse_entry_;
+    buffer<unsigned, Policy> reverse_offset_, reverse_key_, reverse_entry_;
     bool reverse_ready_ = false;
 };
 

@@ -36,8 +36,8 @@
 
 /// SPHERE_UNROLL before a loop with a constant trip count whose index selects struct members
 /// (the six wall faces): unrolled, every index is a constant and the members stay in
-/// registers on CUDA instead of local memory.
-#if defined(__CUDACC__)
+/// registers on CUDA instead of local memory (nvcc's host pass, g++, gets g++'s pragma).
+#if defined(__CUDA_ARCH__)
 #define SPHERE_UNROLL _Pragma("unroll")
 #elif defined(__GNUC__) && !defined(__clang__)
 #define SPHERE_UNROLL _Pragma("GCC unroll 8")

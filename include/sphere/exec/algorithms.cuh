@@ -1,22 +1,18 @@
 #pragma once
 /// \file
-/// The collective operations the step needs, one dispatch point each per policy:
-/// `sort_by_key` (stable, so equal keys keep their order and results are deterministic) and
-/// `transform_reduce` over an index range.
+/// Reductions over an index range, one dispatch point each per policy: the operators
+/// (`plus_op`, `max_op`, `min_op`) and `transform_reduce`, which returns its result to the host
+/// (diagnostics and set-up; the step's own reductions and the rebuild's sorts and scans go
+/// through an execution context: exec/context.cuh, exec/collectives.cuh).
 ///
 /// Host reductions sum fixed chunks of host_chunk indices and then the chunk results in order,
 /// so a floating-point sum is bit-identical for any number of OpenMP threads.
 ///
-/// Each of these allocates temporary storage on CUDA, and those that return a value to the
-/// host read it back: both count in device_activity() on every backend. The step's own
-/// reductions go through an execution_context instead (exec/context.cuh), which does neither.
+/// transform_reduce allocates temporary storage on CUDA and reads its result back: both count
+/// in device_activity() on every backend.
 #include <cstddef>
 #include <type_traits>
 #include <vector>
-
-#include <thrust/sort.h>
-#include <thrust/system/cpp/execution_policy.h>
-#include <thrust/system/omp/execution_policy.h>
 
 #include "../core/config.cuh"
 #include "activity.cuh"
@@ -28,11 +24,7 @@
 
 #if SPHERE_CUDA_COMPILER
 #include <thrust/execution_policy.h>
-#include <thrust/functional.h>
-#include <thrust/iterator/counting_iterator.h>
-#include <thrust/iterator/reverse_iterator.h>
 #include <thrust/reduce.h>
-#include <thrust/scan.h>
 #endif
 
 namespace sphere {
@@ -49,41 +41,6 @@ struct max_op {
 struct min_op {
     template <class T> SPHERE_HD T operator()(const T& a, const T& b) const { return b < a ? b : a; }
 };
-
-/// Sorts `keys[0, n)` ascending and applies the same permutation to `values`; stable. On the
-/// calling thread when host_team() is 1 (Thrust's OpenMP sort would start all threads).
-template <class Key, class Value>
-void sort_by_key(host, Key* keys, Value* values, std::size_t n)
-{
-    ++device_activity().allocations;
-    if (n >= host_parallel_threshold && host_team() > 1)
-        thrust::stable_sort_by_key(thrust::omp::par, keys, keys + n, values);
-    else thrust::stable_sort_by_key(thrust::cpp::par, keys, keys + n, values);
-}
-
-/// Replaces values[0, n) by their exclusive prefix sums (values[0] becomes 0); returns the
-/// total of the original values. For the offsets of compressed rows.
-inline std::size_t exclusive_scan_in_place(host, unsigned* values, std::size_t n)
-{
-    ++device_activity().allocations;
-    device_activity().read_backs += 2; // the last value before and after the scan
-    std::size_t sum = 0;
-    for (std::size_t i = 0; i < n; ++i) {
-        const unsigned v = values[i];
-        values[i] = static_cast<unsigned>(sum);
-        sum += v;
-    }
-    return sum;
-}
-
-/// Replaces each values[i] by the least of values[i, n) (a suffix minimum). One pass on the
-/// calling thread: a store per value, cheaper than a parallel scan at the sizes it serves.
-inline void suffix_min_in_place(host, unsigned* values, std::size_t n)
-{
-    ++device_activity().allocations;
-    for (std::size_t i = n; i-- > 1;)
-        if (values[i] < values[i - 1]) values[i - 1] = values[i];
-}
 
 namespace detail {
 /// values[i] = f(i): a reduction's transform as a kernel of its own (CUDA).
@@ -140,38 +97,6 @@ T transform_reduce(host, std::size_t n, const Transform& f, T init, Op op)
 }
 
 #if SPHERE_CUDA_COMPILER
-template <class Key, class Value>
-void sort_by_key(cuda, Key* keys, Value* values, std::size_t n)
-{
-    ++device_activity().allocations;
-    detail::guarded("thrust::stable_sort_by_key", [&] { thrust::stable_sort_by_key(thrust::device, keys, keys + n, values); });
-}
-
-inline std::size_t exclusive_scan_in_place(cuda, unsigned* values, std::size_t n)
-{
-    ++device_activity().allocations;
-    device_activity().read_backs += 2;
-    if (n == 0) return 0;
-    unsigned last = 0;
-    detail::check_cuda(cudaMemcpy(&last, values + n - 1, sizeof last, cudaMemcpyDeviceToHost),
-                       "cudaMemcpy (the last value before the scan)");
-    detail::guarded("thrust::exclusive_scan", [&] { thrust::exclusive_scan(thrust::device, values, values + n, values); });
-    unsigned before_last = 0;
-    detail::check_cuda(cudaMemcpy(&before_last, values + n - 1, sizeof before_last, cudaMemcpyDeviceToHost),
-                       "cudaMemcpy (the last value after the scan)");
-    return std::size_t(before_last) + last;
-}
-
-inline void suffix_min_in_place(cuda, unsigned* values, std::size_t n)
-{
-    ++device_activity().allocations;
-    if (n == 0) return;
-    const thrust::reverse_iterator<unsigned*> last_first(values + n);
-    detail::guarded("thrust::inclusive_scan (suffix minimum)", [&] {
-        thrust::inclusive_scan(thrust::device, last_first, last_first + n, last_first, thrust::minimum<unsigned>());
-    });
-}
-
 template <class T, class Transform, class Op>
 T transform_reduce(cuda, std::size_t n, const Transform& f, T init, Op op)
 {
@@ -196,38 +121,6 @@ struct fill_value {
     T value;
     SPHERE_HD void operator()(std::size_t i) const { to[i] = value; }
 };
-
-/// Position k of sorted keys marks where its value (key >> Shift, at most n) starts when it is
-/// the first position with that value: each value present is written once.
-template <class Key, int Shift>
-struct mark_starts {
-    const Key* key;
-    std::size_t n;
-    unsigned* start;
-    SPHERE_HD std::size_t value(std::size_t k) const
-    {
-        const std::size_t v = static_cast<std::size_t>(key[k] >> Shift);
-        return v < n ? v : n;
-    }
-    SPHERE_HD void operator()(std::size_t k) const
-    {
-        const std::size_t v = value(k);
-        if (k == 0 || value(k - 1) != v) start[v] = static_cast<unsigned>(k);
-    }
-};
 } // namespace detail
-
-/// From `count` keys sorted ascending, read as values key >> Shift (values of n or more count
-/// as n), sets start[v] for v = 0 .. n to the first position whose value is at least v (count
-/// when there is none). Every start is set to count, the first position of each value present
-/// marks it, and a suffix minimum gives each absent value the next present one's start: no
-/// thread walks a run of absent values, however many there are.
-template <int Shift = 0, class Policy, class Key>
-void find_starts(Policy, const Key* key, std::size_t count, std::size_t n, unsigned* start)
-{
-    for_each_index(Policy{}, n + 1, detail::fill_value<unsigned>{start, static_cast<unsigned>(count)});
-    for_each_index(Policy{}, count, detail::mark_starts<Key, Shift>{key, n, start});
-    suffix_min_in_place(Policy{}, start, n + 1);
-}
 
 } // namespace sphere

@@ -11,6 +11,7 @@
 #include "../core/vec.cuh"
 #include "../exec/algorithms.cuh"
 #include "../exec/buffer.cuh"
+#include "../exec/context.cuh"
 #include "../exec/for_each.cuh"
 #include "../grid/neighbor_grid.cuh"
 #include "../particles/state.cuh"
@@ -217,7 +218,7 @@ public:
                              " m plus the largest particle radius ", r_max,
                              " m, so a particle could meet a cell sphere through two periodic images; use more fluid "
                              "cells along ", axis_name[a]);
-        bins_.build(p);
+        bins_.build(context_, p);
         detail::estimate_cell_porosity<Real> kernel{grid_, bins_.view(), p.v_sync, R, {0, 0, 0}, {0, 0, 0},
                                                     have_previous_, dt, phi_.data(), dphi_dt_.data(), v_p_.data(),
                                                     d_p_.data()};
@@ -283,6 +284,7 @@ private:
     }
 
     fluid_grid<Real> grid_;
+    execution_context<Policy> context_; ///< the bins' sort and scans
     neighbor_grid<Real, Policy> bins_;
     buffer<Real, Policy> phi_, dphi_dt_;
     buffer<vec3<Real>, Policy> v_p_;

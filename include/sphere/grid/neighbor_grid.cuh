@@ -8,8 +8,9 @@
 #include <type_traits>
 
 #include "../core/vec.cuh"
-#include "../exec/algorithms.cuh"
 #include "../exec/buffer.cuh"
+#include "../exec/collectives.cuh"
+#include "../exec/context.cuh"
 #include "../exec/for_each.cuh"
 #include "../particles/state.cuh"
 #include "geometry.cuh"
@@ -28,19 +29,21 @@ struct grid_view {
 };
 
 namespace detail {
-/// Sort key of slot i: its cell in the high 32 bits, its user index (or its slot when the
-/// view has no user indices) in the low ones.
+/// Sort key of slot i: its cell above bit `tie_bits`, its user index (or its slot when the
+/// view has no user indices) in the bits below, so that the sort needs only as many bits as
+/// the cells and particles take.
 template <class Real>
 struct hash_particles {
     grid_geometry<Real> g;
     const vec4<Real>* x;
     const unsigned* user; ///< may be null
+    int tie_bits;
     unsigned long long* key;
     unsigned* order;
     SPHERE_HD void operator()(std::size_t i) const
     {
         const unsigned tie = user ? user[i] : static_cast<unsigned>(i);
-        key[i] = (static_cast<unsigned long long>(g.cell_of(x[i].xyz())) << 32) | tie;
+        key[i] = (static_cast<unsigned long long>(g.cell_of(x[i].xyz())) << tie_bits) | tie;
         order[i] = static_cast<unsigned>(i);
     }
 };
@@ -58,9 +61,10 @@ public:
     /// is laid in the type of the positions, coord_t of the particles' precision P). The
     /// positions in sorted order go to `sorted_into` (p.n elements of policy memory that the
     /// caller owns and keeps unchanged while it uses the view) or, without it, to the grid's
-    /// own array.
+    /// own array. Sorts and scans through `ctx`: no allocation once the particle count and the
+    /// caller's array stay.
     template <class P>
-    void build(const particle_view<P>& p, vec4<Real>* sorted_into = nullptr)
+    void build(execution_context<Policy>& ctx, const particle_view<P>& p, vec4<Real>* sorted_into = nullptr)
     {
         static_assert(std::is_same_v<coord_t<P>, Real>, "the grid is laid in the type of the positions");
         const std::size_t cells = geometry_.cell_count();
@@ -69,18 +73,19 @@ public:
             order_.resize(p.n);
         }
         if (sorted_into) {
-            own_sorted_x_ = buffer<vec4<Real>, Policy>();
+            if (own_sorted_x_.size()) own_sorted_x_ = buffer<vec4<Real>, Policy>();
             sorted_x_ = sorted_into;
         } else {
-            own_sorted_x_.resize(p.n);
+            if (own_sorted_x_.size() != p.n) own_sorted_x_.resize(p.n);
             sorted_x_ = own_sorted_x_.data();
         }
         if (cell_start_.size() != cells + 1) cell_start_.resize(cells + 1);
-        for_each_index(Policy{}, p.n, detail::hash_particles<Real>{geometry_, p.x, p.user, key_.data(), order_.data()});
-        sort_by_key(Policy{}, key_.data(), order_.data(), p.n);
-        // where each cell starts, for any number of empty cells (a tall box); the cell is the
-        // key's high 32 bits
-        find_starts<32>(Policy{}, key_.data(), p.n, cells, cell_start_.data());
+        const int tie_bits = bits_for(p.n - 1);
+        for_each_index(Policy{}, p.n,
+                       detail::hash_particles<Real>{geometry_, p.x, p.user, tie_bits, key_.data(), order_.data()});
+        sort_by_key(ctx, key_.data(), order_.data(), p.n, tie_bits + bits_for(cells - 1));
+        // where each cell starts, for any number of empty cells (a tall box)
+        find_starts(ctx, key_.data(), tie_bits, p.n, cells, cell_start_.data());
         for_each_index(Policy{}, p.n, detail::gather<vec4<Real>>{p.x, order_.data(), sorted_x_});
     }
 

@@ -100,19 +100,28 @@ struct drift_particles {
     Real dt;
     const vec3<Real>* external; ///< external force on each particle (N), read with External
 
-    SPHERE_HDI void operator()(std::size_t i) const
+    /// Particle i's position (wrapped), velocity and angular velocity after the drift, from
+    /// its fields now; nothing is stored.
+    SPHERE_HDI void drifted(std::size_t i, vec3<Coord>& pos, vec3<Real>& v, vec3<Real>& w) const
     {
         static_assert(!Integrator::distinct_synchronous_velocity, "a drifting integrator keeps one velocity");
         const auto kind = static_cast<motion>(p.kind[i]);
-        vec4<Coord> x = p.x[i];
-        vec3<Coord> pos = x.xyz();
-        vec3<Real> v = p.v[i], w = p.omega[i], angle{0, 0, 0}; // angles are turn_particles' (not stored here)
-        vec3<Real> a, alpha;
+        pos = p.x[i].xyz();
+        v = p.v[i];
+        w = p.omega[i];
+        vec3<Real> angle{0, 0, 0}, a, alpha; // angles are turn_particles' (not stored here)
         accelerations<External>(p, i, kind, gravity, external, a, alpha);
         Integrator::drift(pos, v, a, dt);
         Integrator::drift(angle, w, alpha, dt);
         pos = box.wrap(pos);
-        p.x[i] = {pos.x, pos.y, pos.z, x.w};
+    }
+
+    SPHERE_HDI void operator()(std::size_t i) const
+    {
+        vec3<Coord> pos;
+        vec3<Real> v, w;
+        drifted(i, pos, v, w);
+        p.x[i] = {pos.x, pos.y, pos.z, p.x[i].w};
         p.v[i] = v;
         p.omega[i] = w;
     }
@@ -143,9 +152,11 @@ struct check_particle {
     world<Coord> box;
     wall_set<Coord> walls;
 
-    SPHERE_HDI bool bad(std::size_t i) const
+    SPHERE_HDI bool bad(std::size_t i) const { return bad_at(i, p.x[i].xyz()); }
+
+    /// bad(i), were particle i at `pos`.
+    SPHERE_HDI bool bad_at(std::size_t i, const vec3<Coord>& pos) const
     {
-        vec3<Coord> pos = p.x[i].xyz();
         bool out = !(isfinite(pos) & isfinite(p.v_sync[i]) & isfinite(p.omega_sync[i]));
         for (int a = 0; a < 3; ++a) {
             const bool inside = (pos[a] >= Coord(walls.face[2 * a].position)) & (pos[a] <= Coord(walls.face[2 * a + 1].position));
@@ -154,16 +165,35 @@ struct check_particle {
         return out;
     }
 
-    SPHERE_HDI Coord operator()(std::size_t i) const
+    SPHERE_HDI Coord operator()(std::size_t i) const { return at(i, p.x[i].xyz()); }
+
+    /// The check of particle i, were it at `pos` (wrapped into the box).
+    SPHERE_HDI Coord at(std::size_t i, const vec3<Coord>& pos) const
     {
         // Written so that the displacement is computed whatever the outcome (the compiler
         // cannot load fields conditionally in SIMD lanes): a NaN becomes +infinity, and a bad
         // particle's +infinity wins the maximum.
         const Coord inf = infinity<Coord>;
-        Coord moved = norm2(box.nearest_image_inside(p.x[i].xyz() - x_at_build[i].xyz())); // both wrapped
+        Coord moved = norm2(box.nearest_image_inside(pos - x_at_build[i].xyz())); // both wrapped
         moved = moved == moved ? moved : inf;
-        const Coord flag = bad(i) ? inf : Coord(0);
+        const Coord flag = bad_at(i, pos) ? inf : Coord(0);
         return moved > flag ? moved : flag;
+    }
+};
+
+/// The check of particle i at the position the next drift will give it (velocity Verlet, at
+/// the end of a step: the host then decides the next step's rebuild without waiting for the
+/// drift). Against the walls where they stand now, before they move.
+template <class P, class Integrator, bool External>
+struct check_after_drift {
+    drift_particles<P, Integrator, External> drift;
+    check_particle<P> check;
+    SPHERE_HDI coord_t<P> operator()(std::size_t i) const
+    {
+        vec3<coord_t<P>> pos;
+        vec3<real_t<P>> v, w;
+        drift.drifted(i, pos, v, w);
+        return check.at(i, pos);
     }
 };
 
@@ -175,13 +205,14 @@ struct bad_particle {
     SPHERE_HD std::size_t operator()(std::size_t i) const { return check.bad(i) ? std::size_t(check.p.user[i]) : ~std::size_t(0); }
 };
 
-/// Runs a particle kernel `body` on particle i, then returns the particle check (kernel body
-/// of a transform_reduce: one parallel pass instead of two).
-template <class Body, class P>
+/// Runs a particle kernel `body` on particle i, then returns the particle check `Check`
+/// (check_particle or check_after_drift; kernel body of a transform_reduce: one parallel pass
+/// instead of two).
+template <class Body, class Check>
 struct then_check {
     Body body;
-    check_particle<P> check;
-    SPHERE_HDI coord_t<P> operator()(std::size_t i) const
+    Check check;
+    SPHERE_HDI auto operator()(std::size_t i) const
     {
         body(i);
         return check(i);

@@ -57,6 +57,15 @@ struct gather {
     SPHERE_HD void operator()(std::size_t k) const { to[k] = from[order[k]]; }
 };
 
+/// to[order[k]] = from[k] (kernel body of the inverse of gather).
+template <class T>
+struct scatter {
+    const T* from;
+    const unsigned* order;
+    T* to;
+    SPHERE_HD void operator()(std::size_t k) const { to[order[k]] = from[k]; }
+};
+
 /// to[k] = from[k] (kernel body of a copy).
 template <class T>
 struct copy_back {
@@ -167,6 +176,19 @@ public:
         for_each_index(Policy{}, force_.size(), detail::fill_value<vec3<Real>>{force_.data(), {0, 0, 0}});
     }
 
+    /// Undoes permute(order, sorted_x, along...): every particle and `along` array back into
+    /// the slot it had before; `sorted_x` still holds the positions in the permuted order (the
+    /// forces, scratch, are left zero). Every array keeps its address.
+    template <class... Along>
+    void unpermute(const unsigned* order, const vec4<Coord>* sorted_x, Along&... along)
+    {
+        for_each_index(Policy{}, x_.size(), detail::scatter<vec4<Coord>>{sorted_x, order, x_.data()});
+        each_carried_field([&](auto& field) { unpermute_field(field, order); });
+        unpermute_field(user_, order);
+        (unpermute_field(along, order), ...);
+        for_each_index(Policy{}, force_.size(), detail::fill_value<vec3<Real>>{force_.data(), {0, 0, 0}});
+    }
+
     /// Sets which particle each slot holds (user index per slot), e.g. for a restart; the
     /// fields' contents must be restored afterwards.
     void set_storage_order(const std::vector<unsigned>& user) { user_.assign(user); }
@@ -248,6 +270,18 @@ private:
         T* tmp = reinterpret_cast<T*>(force_.data());
         const std::size_t n = field.size();
         for_each_index(Policy{}, n, detail::gather<T>{field.data(), order, tmp});
+        for_each_index(Policy{}, n, detail::copy_back<T>{tmp, field.data()});
+    }
+
+    /// Scatters one field back through `order` (the inverse of permute_field), by way of the
+    /// forces' array.
+    template <class T>
+    void unpermute_field(buffer<T, Policy>& field, const unsigned* order)
+    {
+        static_assert(sizeof(T) <= sizeof(vec3<Real>) && alignof(T) <= alignof(vec3<Real>), "scratch too narrow");
+        T* tmp = reinterpret_cast<T*>(force_.data());
+        const std::size_t n = field.size();
+        for_each_index(Policy{}, n, detail::scatter<T>{field.data(), order, tmp});
         for_each_index(Policy{}, n, detail::copy_back<T>{tmp, field.data()});
     }
 
