@@ -8,7 +8,10 @@
 //                   [--rebuild]    (one rebuild of the contact lists after the untimed steps, for its memory)
 //
 // Memory: the resident set (VmRSS, /proc/self/status) of the program with its input file, after the
-// untimed steps, and the whole process's peak (VmHWM), per particle.
+// untimed steps, and the whole process's peak (VmHWM), per particle (host backend only).
+//
+// bed_cuda is this file compiled by nvcc with SPHERE_BED_POLICY=sphere::cuda (bench/CMakeLists.txt):
+// the same scenario on the GPU, its line naming the backend instead of the threads.
 #include <sphere/dem.cuh>
 
 #include <CLI/CLI.hpp>
@@ -24,10 +27,18 @@
 #include <random>
 #include <sstream>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
+#ifndef SPHERE_BED_POLICY
+#define SPHERE_BED_POLICY sphere::host
+#endif
+
 namespace {
+
+using policy = SPHERE_BED_POLICY;
+constexpr bool on_host = std::is_same_v<policy, sphere::host>;
 
 struct options {
     std::string csv;
@@ -154,7 +165,7 @@ int run(const options& o, const bed_file& b)
     }
 
     using law = contact::linear<tangential::elastic_viscous_frictional, tangential::elastic_viscous_frictional>;
-    simulation<Precision, host, law, integrate::velocity_verlet> sim(s, std::move(ps)); // no second copy
+    simulation<Precision, policy, law, integrate::velocity_verlet> sim(s, std::move(ps)); // no second copy
     const std::size_t n = sim.size();
     sim.run(o.pre);
     if (o.rebuild) { // the floor stays where it is, but the lists are rebuilt at the next step
@@ -170,16 +181,18 @@ int run(const options& o, const bed_file& b)
     const auto t1 = std::chrono::steady_clock::now();
     const counts c1 = count(sim);
     const double seconds = std::chrono::duration<double>(t1 - t0).count();
-    std::printf("sphere   N=%zu threads=%d precision=%s order=%s loop=%.3f s  %.3e particle-steps/s  contacts "
+    const std::string where = on_host ? "threads=" + std::to_string(o.threads) : "backend=cuda";
+    std::printf("sphere   N=%zu %s precision=%s order=%s loop=%.3f s  %.3e particle-steps/s  contacts "
                 "%.4f -> %.4f  wall %zu -> %zu  KE/(N m g d) %.2e -> %.2e  rebuilds %zu\n",
-                n, o.threads, o.precision.c_str(), o.order.c_str(), seconds, double(n) * double(o.steps) / seconds,
+                n, where.c_str(), o.precision.c_str(), o.order.c_str(), seconds, double(n) * double(o.steps) / seconds,
                 c0.pair_contacts_per_particle, c1.pair_contacts_per_particle, c0.wall_contacts, c1.wall_contacts,
                 c0.kinetic, c1.kinetic, sim.rebuilds() - rebuilds0);
-    std::printf("memory   N=%zu precision=%s  RSS of the program and input %.0f MB; after %zu steps %.0f MB: simulation "
-                "+%.0f B/particle; peak %.0f B/particle for the whole process (set-up, particle descriptions and "
-                "rebuilds included)\n",
-                n, o.precision.c_str(), rss_program / 1e6, o.pre, rss_sim / 1e6, (rss_sim - rss_program) / double(n),
-                peak_sim / double(n));
+    if (on_host) // the CUDA backend's particles are not in the resident set
+        std::printf("memory   N=%zu precision=%s  RSS of the program and input %.0f MB; after %zu steps %.0f MB: "
+                    "simulation +%.0f B/particle; peak %.0f B/particle for the whole process (set-up, particle "
+                    "descriptions and rebuilds included)\n",
+                    n, o.precision.c_str(), rss_program / 1e6, o.pre, rss_sim / 1e6,
+                    (rss_sim - rss_program) / double(n), peak_sim / double(n));
     return 0;
 }
 

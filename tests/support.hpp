@@ -5,11 +5,20 @@
 // where each test asserts.
 #include <sphere/dem.cuh>
 
+// The backend the physics tests run on: the host test binaries leave it unset (sphere::host);
+// the CUDA test binary (tests/cuda/tests.cu) compiles the same test sources with sphere::cuda.
+#ifndef SPHERE_TEST_POLICY
+#define SPHERE_TEST_POLICY sphere::host
+#endif
+
 #include <cmath>
 #include <type_traits>
 #include <vector>
 
 namespace sphere_test {
+
+/// The execution policy of the simulations the physics tests create.
+using policy = SPHERE_TEST_POLICY;
 
 /// The type in which a simulation of precision P takes and hands out values (settings,
 /// particles, snapshots): P itself, or double for sphere::mixed.
@@ -76,6 +85,13 @@ sphere::particle<Real> ball(sphere::vec3<Real> position, sphere::vec3<Real> velo
     p.density = set_p<Real>::density;
     p.velocity = velocity;
     return p;
+}
+
+/// A vector's components in double.
+template <class Real>
+sphere::vec3<double> to_double(const sphere::vec3<Real>& a)
+{
+    return {static_cast<double>(a.x), static_cast<double>(a.y), static_cast<double>(a.z)};
 }
 
 /// |a - b| / |b|

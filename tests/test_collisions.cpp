@@ -3,7 +3,8 @@
 // without sliding, between two particles and against a wall) and the restitution helpers of
 // contact/restitution.cuh. Set P throughout (support.hpp): R = 0.01 m, rho = 2500 kg/m^3
 // (m = 1.047198e-2 kg), k_n = 1e5 N/m, k_t = 2/7 k_n, no gravity, particles near the origin.
-// Every test runs on the host backend in float and double.
+// Every test runs in float and double (most also in mixed), on the host backend and, in the CUDA
+// test binary (tests/cuda/tests.cu), on sphere::cuda.
 //
 // Where a result at the default time step depends on where the contact starts within a step
 // (the "entry phase"), the test sweeps the entry phase instead of picking one.
@@ -24,9 +25,10 @@ using sphere_test::ball;
 using sphere_test::box_settings;
 using sphere_test::rel_err;
 using sphere_test::set_p;
+using sphere_test::to_double;
 
 template <class P, class Integrator = sphere::integrate::semi_implicit_euler>
-using host_sim = sphere::simulation<P, sphere::host, sphere::contact::linear<>, Integrator>;
+using test_sim = sphere::simulation<P, sphere_test::policy, sphere::contact::linear<>, Integrator>;
 using sphere_test::single_fields;
 using sphere_test::user_real;
 
@@ -45,12 +47,6 @@ constexpr double gamma_wall = 13.944354; // N s/m
 /// (j + 1/2)/n_phases of the distance the bodies close in one step.
 constexpr int n_phases = 8;
 double entry_gap(int j, double closing_speed, double dt) { return (j + 0.5) / n_phases * closing_speed * dt; }
-
-template <class Real>
-vec3<double> to_double(const vec3<Real>& a)
-{
-    return {static_cast<double>(a.x), static_cast<double>(a.y), static_cast<double>(a.z)};
-}
 
 double norm_d(const vec3<double>& a) { return std::sqrt(a.x * a.x + a.y * a.y + a.z * a.z); }
 
@@ -154,7 +150,7 @@ template <class P, class Integrator = sphere::integrate::semi_implicit_euler, cl
 head_on_result head_on(Real r_a, Real r_b, Real gap)
 {
     const sphere::settings<Real> s = box_settings<Real>();
-    host_sim<P, Integrator> sim(s, {ball<Real>({-(r_a + gap / 2), 0, 0}, {1, 0, 0}, r_a),
+    test_sim<P, Integrator> sim(s, {ball<Real>({-(r_a + gap / 2), 0, 0}, {1, 0, 0}, r_a),
                                        ball<Real>({r_b + gap / 2, 0, 0}, {0, 0, 0}, r_b)});
     head_on_result out;
     out.dt = sim.dt();
@@ -194,7 +190,7 @@ damped_result damped_collision(bool wall, bool tension, Real dt, Real gap)
     } else {
         particles = {ball<Real>({-(r + gap / 2), 0, 0}, {1, 0, 0}), ball<Real>({r + gap / 2, 0, 0})};
     }
-    host_sim<P, Integrator> sim(s, particles);
+    test_sim<P, Integrator> sim(s, particles);
     REQUIRE(sim.dt() == Real(sphere::real_t<P>(dt))); // mixed: dt is rounded to float, the velocities' type
     damped_result out;
     out.ke0 = sim.energy().kinetic;
@@ -235,7 +231,7 @@ oblique_result oblique_pair(vec3<Real> v_a, Real mu, Real dt)
     sphere::settings<Real> s = box_settings<Real>();
     s.contact.mu_s = s.contact.mu_d = mu;
     s.dt = dt;
-    host_sim<P> sim(s, {ball<Real>({0, 0, -r}, v_a), ball<Real>({0, 0, r})});
+    test_sim<P> sim(s, {ball<Real>({0, 0, -r}, v_a), ball<Real>({0, 0, r})});
     REQUIRE(sim.dt() == Real(sphere::real_t<P>(dt))); // mixed: dt is rounded to float, the velocities' type
     oblique_result out;
     out.e0 = sim.energy().kinetic;
@@ -667,7 +663,7 @@ TEMPLATE_TEST_CASE("D6: oblique impact on a wall, sliding", "[collision][D6]", f
         s.wall.gamma_t = Real(100);
         s.wall.mu_s = s.wall.mu_d = Real(0.3);
         s.dt = Real(dt_p / refine);
-        host_sim<P> sim(s, {ball<Real>({0, 0, 0}, {Real(0.05), 0, Real(-0.01)})});
+        test_sim<P> sim(s, {ball<Real>({0, 0, 0}, {Real(0.05), 0, Real(-0.01)})});
         const double e0 = sim.energy().kinetic;
         const double z_wall = static_cast<double>(s.box.lo.z);
         const contact_record c = watch_collision(
@@ -719,7 +715,7 @@ TEMPLATE_TEST_CASE("angular position: the time integral of the angular velocity"
     const std::size_t steps = 2000;
     SECTION("semi-implicit Euler: every step")
     {
-        host_sim<P> sim(s, ball_on_floor);
+        test_sim<P> sim(s, ball_on_floor);
         double phi = 0;
         for (std::size_t k = 0; k < steps; ++k) {
             sim.step();
@@ -734,8 +730,7 @@ TEMPLATE_TEST_CASE("angular position: the time integral of the angular velocity"
     }
     SECTION("velocity Verlet: the free spin after the impact")
     {
-        sphere::simulation<P, sphere::host, sphere::contact::linear<>, sphere::integrate::velocity_verlet> sim(
-            s, ball_on_floor);
+        test_sim<P, sphere::integrate::velocity_verlet> sim(s, ball_on_floor);
         sim.run(steps / 2);
         const auto before = sim.snapshot();
         sim.run(steps / 2);
@@ -774,7 +769,7 @@ TEMPLATE_TEST_CASE("mass-scaled damping: each pair gets c = gamma m*, so its res
         s.contact.tension = true;
         s.dt = Real(dt_p / 10);
         const Real gap = Real(1e-4);
-        host_sim<P> sim(s, {ball<Real>({-(Real(pc.r_a) + gap / 2), 0, 0}, {1, 0, 0}, Real(pc.r_a)),
+        test_sim<P> sim(s, {ball<Real>({-(Real(pc.r_a) + gap / 2), 0, 0}, {1, 0, 0}, Real(pc.r_a)),
                                ball<Real>({Real(pc.r_b) + gap / 2, 0, 0}, {0, 0, 0}, Real(pc.r_b))});
         const contact_record c =
             watch_collision(sim, [](const auto& snap) { return pair_state(snap); }, k_n_p, gamma * m_eff, true, 200000);
@@ -788,6 +783,6 @@ TEMPLATE_TEST_CASE("mass-scaled damping: each pair gets c = gamma m*, so its res
     sphere::settings<Real> s = box_settings<Real>();
     s.contact.damping = sphere::damping_convention::mass_scaled;
     s.contact.gamma_n = Real(-1);
-    REQUIRE_THROWS_WITH((host_sim<P>(s, {ball<Real>({0, 0, 0})})),
+    REQUIRE_THROWS_WITH((test_sim<P>(s, {ball<Real>({0, 0, 0})})),
                         Catch::Contains("settings.contact.gamma_n = -1 1/s (mass-scaled): must be non-negative"));
 }

@@ -1,6 +1,7 @@
 // Tangential contact forces: VALIDATION.md cases D7 (sliding to rolling on a floor), D8 (a
 // sphere on an incline) and D9 (cyclic tangential loading of a pair with prescribed
-// kinematics). Set P throughout (R = 0.01 m, rho = 2500 kg/m^3, k_n = 1e5 N/m), host backend.
+// kinematics). Set P throughout (R = 0.01 m, rho = 2500 kg/m^3, k_n = 1e5 N/m), on the host backend
+// and, in the CUDA test binary (tests/cuda/tests.cu), on sphere::cuda.
 //
 // D7 and D8 use the default wall law (visco-frictional, f_t = -gamma_wt v_t capped by
 // mu_w |f_n|); D9 the default pair law (elastic-viscous-frictional spring with Coulomb limit).
@@ -22,17 +23,12 @@ using sphere_test::ball;
 using sphere_test::box_settings;
 using sphere_test::rel_err;
 using sphere_test::set_p;
+using sphere_test::to_double;
 
 namespace {
 
 constexpr double g_earth = 9.81;       // m/s^2, VALIDATION D7/D8
 constexpr double pi_d = 3.14159265358979323846;
-
-template <class Real>
-vec3<double> to_double(const vec3<Real>& a)
-{
-    return {static_cast<double>(a.x), static_cast<double>(a.y), static_cast<double>(a.z)};
-}
 
 // ---------------------------------------------------------------------------------------------
 // D7 / D8: one sphere on the floor
@@ -101,7 +97,7 @@ struct shear_pair {
     static constexpr double dt_set = 2.5e-5;
     static constexpr std::size_t A = 0, B = 1;
 
-    sphere::simulation<P> sim;
+    sphere::simulation<P, sphere_test::policy> sim;
     double dt;
     double work = 0; ///< work done by the drive on the pair so far, sum (f_drive . v + tau_drive . omega) dt (J)
 
@@ -117,7 +113,7 @@ struct shear_pair {
     std::vector<sample> log;
     double s = 0;
 
-    static sphere::simulation<P> make(Real mu_s, Real mu_d)
+    static sphere::simulation<P, sphere_test::policy> make(Real mu_s, Real mu_d)
     {
         sphere::settings<Real> st = box_settings<Real>(); // walls at +-0.1 m: never touched
         st.contact.k_t = set_p<Real>::k_n * Real(2) / Real(7);
@@ -127,7 +123,7 @@ struct shear_pair {
         sphere::particle<Real> a = ball<Real>({0, 0, 0});
         sphere::particle<Real> b = ball<Real>({0, 0, z_for_overlap<Real>(1e-4)});
         a.kind = b.kind = sphere::motion::prescribed;
-        return sphere::simulation<P>(st, {a, b});
+        return sphere::simulation<P, sphere_test::policy>(st, {a, b});
     }
 
     shear_pair(Real mu_s, Real mu_d) : sim(make(mu_s, mu_d)), dt(static_cast<double>(sim.dt())) {}
@@ -216,7 +212,7 @@ TEMPLATE_TEST_CASE("D7 sphere sliding to rolling on a floor", "[tangential][wall
     st.gravity = {0, 0, Real(-g_earth)};
     const Real m = set_p<Real>::mass();
     const Real overlap0 = m * Real(g_earth) / set_p<Real>::k_n; // m g / k_n = 1.0273e-6 m: at rest on the floor
-    sphere::simulation<P> sim(st, {ball<Real>({0, 0, set_p<Real>::radius - overlap0}, {1, 0, 0})});
+    sphere::simulation<P, sphere_test::policy> sim(st, {ball<Real>({0, 0, set_p<Real>::radius - overlap0}, {1, 0, 0})});
     const double dt = sim.dt();
     const double L = 0.1;
 
@@ -320,7 +316,7 @@ incline_result incline(double deg, int axis)
                   Real(-g_earth * std::cos(th))};
     const Real m = set_p<Real>::mass();
     const Real overlap0 = static_cast<Real>(static_cast<double>(m) * g_earth * std::cos(th) / 1e5);
-    sphere::simulation<P> sim(st, {ball<Real>({0, 0, set_p<Real>::radius - overlap0})});
+    sphere::simulation<P, sphere_test::policy> sim(st, {ball<Real>({0, 0, set_p<Real>::radius - overlap0})});
     const vec3<double> spin_axis = cross(vec3<double>{0, 0, 1}, down_slope); // omega of rolling down-slope
     const double dt = sim.dt();
     const std::size_t k1 = static_cast<std::size_t>(std::lround(0.01 / dt));

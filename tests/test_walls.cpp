@@ -1,6 +1,7 @@
 // Dynamic walls (issue 3): D10 of ../shared/VALIDATION.md — a simple-cubic column under a
 // stress-controlled and under a velocity-controlled upper wall — a stress-controlled wall on
 // a random sample, sine modulation, the energy budget with moving walls, and wall errors.
+// Runs on the host backend and, in the CUDA test binary (tests/cuda/tests.cu), on sphere::cuda.
 #include <catch2/catch.hpp>
 
 #include "support.hpp"
@@ -60,7 +61,7 @@ TEMPLATE_TEST_CASE("D10: a stress-controlled wall compresses a simple-cubic colu
     s.walls[5].mode = sphere::wall_mode::stress;
     s.walls[5].stress = Real(sigma0);
     s.walls[5].mass = Real(0.05); // kg
-    sphere::simulation<P> sim(s, p);
+    sphere::simulation<P, sphere_test::policy> sim(s, p);
     sim.run(40000); // ~1 s: the column and the wall come to rest
     // Each of the 16 columns carries sigma0 A / 16 = 4 N through 11 contacts (9 pairs, floor,
     // wall): compression 11 * 4 N / k_n = 4.4e-4 m. Tolerance 0.1% (VALIDATION D10).
@@ -82,7 +83,7 @@ TEMPLATE_TEST_CASE("D10: with gravity the floor carries the wall stress plus the
     s.walls[5].mode = sphere::wall_mode::stress;
     s.walls[5].stress = Real(1e4);
     s.walls[5].mass = Real(0.05);
-    sphere::simulation<P> sim(s, p);
+    sphere::simulation<P, sphere_test::policy> sim(s, p);
     sim.run(40000);
     // 1e4 Pa * 0.0064 m^2 + 160 * 1.047198e-2 kg * 9.81 m/s^2 = 80.437 N (VALIDATION D10), 0.1%.
     const double floor_force = -mean_wall_force(sim, 4, 2000);
@@ -102,7 +103,7 @@ TEMPLATE_TEST_CASE("D10: a velocity-controlled wall gives the analytic stress", 
     down.mode = sphere::wall_mode::velocity;
     down.velocity = Real(0.002);
     s.walls[5] = down;
-    sphere::simulation<P> sim(s, p);
+    sphere::simulation<P, sphere_test::policy> sim(s, p);
     const std::size_t moving = static_cast<std::size_t>(std::lround(0.65 / double(sim.dt())));
     sim.run(moving);
     sim.set_wall_control(5, sphere::wall_control<Real>{}); // fixed from now on
@@ -144,7 +145,7 @@ TEMPLATE_TEST_CASE("a stress-controlled wall holds its target on a random sample
     s.walls[5].mode = sphere::wall_mode::stress;
     s.walls[5].stress = Real(sigma0);
     s.walls[5].mass = Real(0.5);
-    sphere::simulation<P> sim(s, p);
+    sphere::simulation<P, sphere_test::policy> sim(s, p);
     sim.run(30000); // consolidation
     // Time-averaged over a window the wall holds sigma0 within 1% (issue 3, test 1).
     const double held = mean_wall_force(sim, 5, 4000) / area;
@@ -183,7 +184,7 @@ TEMPLATE_TEST_CASE("the energy budget closes with a moving wall", "[walls][energ
         s.walls[5].stress = Real(1e4);
         s.walls[5].mass = Real(0.1);
         s.dt = dt_factor * set_p<Real>::dt();
-        sphere::simulation<P> sim(s, p);
+        sphere::simulation<P, sphere_test::policy> sim(s, p);
         const double total0 = double(sim.energy().total());
         sim.run(static_cast<std::size_t>(std::lround(0.1 / double(sim.dt()))));
         const auto e = sim.energy();
@@ -201,7 +202,10 @@ TEMPLATE_TEST_CASE("bad wall controls are refused with the face named", "[walls]
     using P = TestType;
     using Real = sphere_test::user_real<P>;
     auto [s, p] = d10_column<Real>(0);
-    auto build = [&](const sphere::settings<Real>& t) { sphere::simulation<P> sim(t, p); };
+    // (p by an init-capture: capturing a structured binding is C++20, and nvcc warns.)
+    auto build = [&particles = p](const sphere::settings<Real>& t) {
+        sphere::simulation<P, sphere_test::policy> sim(t, particles);
+    };
     SECTION("a moving wall on a periodic axis")
     {
         s.walls[0].mode = sphere::wall_mode::velocity;
@@ -222,12 +226,12 @@ TEMPLATE_TEST_CASE("bad wall controls are refused with the face named", "[walls]
     {
         s.walls[5].mode = sphere::wall_mode::velocity;
         s.walls[5].velocity = Real(-1); // outwards, 1 m/s: leaves the 1 mm margin in ~40 steps
-        sphere::simulation<P> sim(s, p);
+        sphere::simulation<P, sphere_test::policy> sim(s, p);
         REQUIRE_THROWS_WITH(sim.run(100), Catch::Contains("wall face 5 moved to") && Catch::Contains("outside the world"));
     }
     SECTION("set_wall_control checks the same")
     {
-        sphere::simulation<P> sim(s, p);
+        sphere::simulation<P, sphere_test::policy> sim(s, p);
         sphere::wall_control<Real> c;
         c.mode = sphere::wall_mode::stress;
         REQUIRE_THROWS_WITH(sim.set_wall_control(5, c), Catch::Contains("settings.walls[5].mass = 0 kg"));
@@ -245,7 +249,7 @@ TEMPLATE_TEST_CASE("set_wall_position moves a wall onto the sample and refuses i
     s.box.hi.z = Real(0.5);                          // plenty of headroom above the column
     s.walls[5].mode = sphere::wall_mode::velocity;
     s.walls[5].velocity = Real(0.01);
-    sphere::simulation<P> sim(s, p);
+    sphere::simulation<P, sphere_test::policy> sim(s, p);
     // Wall faces 0-3 lie on periodic axes.
     CHECK_THROWS_WITH(sim.set_wall_position(0, 0.01), Catch::Contains("axis 0 is periodic, so face 0 has no wall"));
     CHECK_THROWS_WITH(sim.set_wall_position(6, 0.01), Catch::Contains("face 6 out of range"));

@@ -193,8 +193,10 @@ struct simulation_state {
 /// grid's cell order; every particle gathers contact forces; integrate; check every particle (a
 /// non-finite value or a particle outside the world on a wall axis stops the run with a
 /// sphere::error naming the step and the particle's user index); advance time; call the
-/// observers that are due. Velocity Verlet drifts the particles first and checks them before
-/// the forces (docs/architecture.md, "One step").
+/// observers that are due. Velocity Verlet drifts the particles first; its check at the end of
+/// a step is of the positions the next drift gives (docs/architecture.md, "One step"). A step
+/// reads back from the device once (twice when its rebuild outgrows the contact lists, which
+/// then grow, or after the host changed what velocity Verlet's drift reads).
 template <class Precision, class Policy = host, class Law = contact::linear<>,
           class Integrator = integrate::semi_implicit_euler>
 class simulation {

@@ -4,11 +4,11 @@
 
 namespace sphere {
 
-/// Kernels run on CPU threads through OpenMP; sorting through Thrust's OpenMP system.
-/// Every test runs on this backend.
+/// Kernels run on CPU threads through OpenMP (sorts and scans on the calling thread). Every
+/// test runs on this backend; the CUDA test binary runs some of the same sources on `cuda`.
 struct host {};
 
-/// Kernels run on an NVIDIA GPU; sorting and reductions through Thrust/CUB.
+/// Kernels run on an NVIDIA GPU; sorts, scans and reductions through CUB (and Thrust).
 /// Usable only in translation units compiled by nvcc.
 struct cuda {};
 

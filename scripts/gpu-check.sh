@@ -1,0 +1,79 @@
+#!/usr/bin/env bash
+# The GPU check, for a machine with an NVIDIA GPU: builds the CUDA test binary and the CUDA bed
+# benchmark for this GPU in build-gpu/, runs the tests (they print the host-vs-CUDA comparison),
+# times bed_cuda on the dense bed at 1e5, 1e6 and 4e6 particles in float, mixed and double, and
+# writes the figures with the date, commit and GPU into a markdown file that
+# docs/performance.md can quote.
+#
+#   bash scripts/gpu-check.sh [output=docs/gpu-results.md]
+#
+# needs: nvcc, the NVIDIA driver (nvidia-smi), the build dependencies (scripts/install-deps.sh),
+# xz, and ../shared/bench/bed/data/bed_50000.csv.xz (or SPHERE_BED_DIR). Exits non-zero when
+# there is no GPU, and after the benchmarks when a test failed.
+set -euo pipefail
+cd "$(dirname "${BASH_SOURCE[0]}")/.."
+out=${1:-docs/gpu-results.md}
+bed_csv_xz=${SPHERE_BED_DIR:-../shared/bench/bed}/data/bed_50000.csv.xz
+fail() { echo "gpu-check: $*" >&2; exit 1; }
+
+command -v nvidia-smi >/dev/null || fail "no nvidia-smi: this machine has no NVIDIA driver, so no GPU to check"
+gpu=$(nvidia-smi --query-gpu=name,driver_version --format=csv,noheader 2>/dev/null | head -n 1) || true
+[[ -n $gpu ]] || fail "nvidia-smi lists no GPU"
+[[ -f $bed_csv_xz ]] || fail "no $bed_csv_xz (set SPHERE_BED_DIR to the folder of the bed scenario)"
+
+cmake -S . -B build-gpu -DCMAKE_BUILD_TYPE=Release -DSPHERE_ENABLE_CUDA=ON -DCMAKE_CUDA_ARCHITECTURES=native
+cmake --build build-gpu -j "$(nproc)" --target sphere_cuda_tests bed_cuda
+
+work=$(mktemp -d); trap 'rm -rf "$work"' EXIT
+tests=passed
+build-gpu/tests/sphere_cuda_tests 2>&1 | tee "$work/tests.log" || tests=FAILED
+grep -q "no CUDA device" "$work/tests.log" && fail "the CUDA runtime finds no device although nvidia-smi lists $gpu"
+
+# The 50,000-particle bed is periodic in x and y: tiled 2 x 1, 4 x 5 and 8 x 10 it holds 1e5,
+# 1e6 and 4e6 particles.
+xz -dc "$bed_csv_xz" > "$work/bed_50000.csv"
+for tile in "2 1" "4 5" "8 10"; do
+    for precision in float mixed double; do
+        # shellcheck disable=SC2086 # the tile is two arguments
+        build-gpu/bench/bed_cuda --csv "$work/bed_50000.csv" --tile $tile --precision "$precision" | tee -a "$work/bed.log"
+    done
+done
+
+# The table: one row per N, particle-steps/s per precision (the number before "particle-steps/s").
+table=$(awk '
+    /^sphere / {
+        match($0, /N=[0-9]+/); n = substr($0, RSTART + 2, RLENGTH - 2)
+        match($0, /precision=[a-z]+/); p = substr($0, RSTART + 10, RLENGTH - 10)
+        for (i = 1; i <= NF; ++i) if ($i == "particle-steps/s") rate[n, p] = $(i - 1)
+        if (!(n in seen)) { seen[n] = 1; order[++rows] = n }
+    }
+    END {
+        print "| N | float | mixed | double |"
+        print "|---|---|---|---|"
+        for (r = 1; r <= rows; ++r) {
+            n = order[r]
+            print "| " n " | " rate[n, "float"] " | " rate[n, "mixed"] " | " rate[n, "double"] " |"
+        }
+    }' "$work/bed.log")
+commit=$(git rev-parse --short HEAD)
+git diff --quiet HEAD || commit="$commit with local changes"
+{
+    echo "# CUDA results (scripts/gpu-check.sh)"
+    echo
+    echo "Measured $(date -u +%FT%TZ), commit $commit, GPU $gpu (name, driver), $(nvcc --version | tail -n 1)."
+    echo
+    echo "sphere_cuda_tests: $tests ($(grep -E "All tests passed|test cases:" "$work/tests.log" | tail -n 1))."
+    echo
+    grep "^host vs CUDA" "$work/tests.log" || echo "(no host-vs-CUDA comparison line)"
+    echo
+    echo "Dense bed (bench/bed.cpp built as bed_cuda; ../shared/bench/bed, 200 untimed and 2000 timed steps),"
+    echo "the 50,000-particle bed tiled 2 x 1, 4 x 5 and 8 x 10; particle-steps/s:"
+    echo
+    echo "$table"
+    echo
+    echo "bed_cuda's lines:"
+    echo
+    sed 's/^/    /' "$work/bed.log"
+} > "$out"
+echo "gpu-check: wrote $out"
+[[ $tests == passed ]] || fail "sphere_cuda_tests failed (above)"
