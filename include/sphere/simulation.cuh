@@ -273,12 +273,13 @@ public:
         summation_ = interaction<Precision, Policy>::resolve(s.pair_summation);
         x_at_build_.resize(n);
         report_.resize(1);
-        // The first build learns the lists' capacities (each overflow grows them).
+        // The first build learns the lists' sizes and takes no more memory than they need (a
+        // static bed never grows); later overflows grow the lists a quarter above their need.
         detail::step_report<Coord>* report = report_.data();
         for (list_totals t{};;) {
             rebuild_lists(&report->lists);
             context_.read_back(&t, &report->lists, 1, "the contact lists' totals", 0);
-            if (settle_rebuild(t)) break;
+            if (settle_rebuild(t, false)) break;
         }
         // An integrator that kicks before the forces needs the forces of the start.
         if (Integrator::drifts_before_forces)
@@ -563,9 +564,9 @@ private:
     /// Takes the totals of rebuild_lists(), read back: true when the lists are complete, false
     /// when they overflowed their capacities, which have now grown, and the particles are back
     /// in their slots, for the rebuild to run again.
-    bool settle_rebuild(const list_totals& t)
+    bool settle_rebuild(const list_totals& t, bool headroom = true)
     {
-        if (!lists_.settle(t)) {
+        if (!lists_.settle(t, headroom)) {
             if (settings_.reorder) particles_.unpermute(grid_.view().order, x_at_build_.data(), external_);
             return false;
         }

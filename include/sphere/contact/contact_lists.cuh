@@ -567,10 +567,11 @@ public:
     }
 
     /// Takes the totals of the last rebuild, read back. Returns true when its lists are
-    /// complete. After an overflow it grows the capacities (a quarter above what the rebuild
-    /// needed), puts the old lists back in use when their histories did not fit, and returns
-    /// false: the caller puts the particles back where they were and rebuilds again.
-    bool settle(const list_totals& t)
+    /// complete. After an overflow it grows the capacities (to what the rebuild needed, with
+    /// `headroom` a quarter above), puts the old lists back in use when their histories did not
+    /// fit, and returns false: the caller puts the particles back where they were and rebuilds
+    /// again.
+    bool settle(const list_totals& t, bool headroom = true)
     {
         if (!t.overflow) {
             entries_ = t.entries;
@@ -583,7 +584,8 @@ public:
             offset_.swap(next_offset_); // the old lists are whole: their histories were not copied
             histories_kept_ = false;
         }
-        reserve(t.entries > capacity() ? with_headroom(t.entries) : 0, t.kept > kept_capacity() ? with_headroom(t.kept) : 0);
+        const auto grown = [&](std::size_t needed) { return headroom ? needed + needed / 4 + 64 : needed; };
+        reserve(t.entries > capacity() ? grown(t.entries) : 0, t.kept > kept_capacity() ? grown(t.kept) : 0);
         return false;
     }
 
@@ -726,7 +728,6 @@ public:
 
 private:
     std::size_t kept_capacity() const { return kept_partner_.size(); }
-    static std::size_t with_headroom(std::size_t needed) { return needed + needed / 4 + 64; }
 
     /// Copies the entries whose history is not zero (contacts that touched at the last step,
     /// whose history a rebuild carries over) into the kept entries, in rows by slot.
