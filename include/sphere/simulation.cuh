@@ -273,6 +273,7 @@ public:
         summation_ = interaction<Precision, Policy>::resolve(s.pair_summation);
         x_at_build_.resize(n);
         report_.resize(1);
+        const stream_scope<Policy> on_stream(context_);
         // The first build learns the lists' sizes and takes no more memory than they need (a
         // static bed never grows); later overflows grow the lists a quarter above their need.
         detail::step_report<Coord>* report = report_.data();
@@ -289,6 +290,7 @@ public:
     /// One DEM step of length dt().
     void step()
     {
+        const stream_scope<Policy> on_stream(context_);
         governor_.step();
         if (external_.size()) step_with<true>();
         else step_with<false>();
@@ -319,6 +321,7 @@ public:
                          ") m/s or angular velocity (", omega.x, ", ", omega.y, ", ", omega.z, ") rad/s is not finite");
         const std::vector<unsigned> user = particles_.user_indices();
         const std::size_t slot = static_cast<std::size_t>(std::find(user.begin(), user.end(), unsigned(i)) - user.begin());
+        const stream_scope<Policy> on_stream(context_);
         for_each_index(Policy{}, 1,
                        detail::set_kinematics<Precision>{particles_.view(), slot, vec_cast<Real>(v), vec_cast<Real>(omega)});
         drift_checked_ = false;
@@ -474,6 +477,7 @@ public:
                 detail::fail("restore: the state's storage order is not a permutation (slot ", k, " holds ", s.storage[k], ")");
             seen[s.storage[k]] = 1;
         }
+        const stream_scope<Policy> on_stream(context_);
         // The ranks of the last rebuild follow from its positions and the user indices: the
         // grid over those positions, in user order. The particles go back into rank order
         // (or stay in user order without settings.reorder), whatever order the state was

@@ -109,7 +109,7 @@ T transform_reduce(cuda, std::size_t n, const Transform& f, T init, Op op)
     buffer<T, cuda> values(n);
     for_each_index(cuda{}, n, detail::store_values<T, Transform>{f, values.data()});
     T* first = values.data();
-    return detail::guarded("thrust::reduce", [&] { return thrust::reduce(thrust::device, first, first + n, init, op); });
+    return detail::guarded("thrust::reduce", [&] { return thrust::reduce(thrust::cuda::par.on(detail::current_stream()), first, first + n, init, op); });
 }
 #endif
 

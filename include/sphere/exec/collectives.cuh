@@ -91,18 +91,18 @@ void sort_by_key(execution_context<cuda>& ctx, Key* keys, Value* values, std::si
     cub::DoubleBuffer<Key> k(keys, nullptr);
     cub::DoubleBuffer<Value> v(values, nullptr);
     std::size_t temp = 0;
-    detail::check_cuda(cub::DeviceRadixSort::SortPairs(nullptr, temp, k, v, n, 0, bits, cudaStream_t(0)),
+    detail::check_cuda(cub::DeviceRadixSort::SortPairs(nullptr, temp, k, v, n, 0, bits, ctx.stream()),
                        "cub::DeviceRadixSort::SortPairs (size query)");
     const std::size_t key_bytes = detail::aligned_bytes(n * sizeof(Key)), value_bytes = detail::aligned_bytes(n * sizeof(Value));
     unsigned char* base = static_cast<unsigned char*>(ctx.scratch(key_bytes + value_bytes + temp));
     k = cub::DoubleBuffer<Key>(keys, reinterpret_cast<Key*>(base));
     v = cub::DoubleBuffer<Value>(values, reinterpret_cast<Value*>(base + key_bytes));
-    detail::check_cuda(cub::DeviceRadixSort::SortPairs(base + key_bytes + value_bytes, temp, k, v, n, 0, bits, cudaStream_t(0)),
+    detail::check_cuda(cub::DeviceRadixSort::SortPairs(base + key_bytes + value_bytes, temp, k, v, n, 0, bits, ctx.stream()),
                        "cub::DeviceRadixSort::SortPairs");
     if (k.Current() != keys) {
-        detail::check_cuda(cudaMemcpyAsync(keys, k.Current(), n * sizeof(Key), cudaMemcpyDeviceToDevice, 0),
+        detail::check_cuda(cudaMemcpyAsync(keys, k.Current(), n * sizeof(Key), cudaMemcpyDeviceToDevice, ctx.stream()),
                            "cudaMemcpyAsync (sorted keys)");
-        detail::check_cuda(cudaMemcpyAsync(values, v.Current(), n * sizeof(Value), cudaMemcpyDeviceToDevice, 0),
+        detail::check_cuda(cudaMemcpyAsync(values, v.Current(), n * sizeof(Value), cudaMemcpyDeviceToDevice, ctx.stream()),
                            "cudaMemcpyAsync (sorted values)");
     }
 }
@@ -111,9 +111,9 @@ inline void exclusive_scan(execution_context<cuda>& ctx, unsigned* values, std::
 {
     if (n == 0) return;
     std::size_t temp = 0;
-    detail::check_cuda(cub::DeviceScan::ExclusiveSum(nullptr, temp, values, n, cudaStream_t(0)),
+    detail::check_cuda(cub::DeviceScan::ExclusiveSum(nullptr, temp, values, n, ctx.stream()),
                        "cub::DeviceScan::ExclusiveSum (size query)");
-    detail::check_cuda(cub::DeviceScan::ExclusiveSum(ctx.scratch(temp), temp, values, n, cudaStream_t(0)),
+    detail::check_cuda(cub::DeviceScan::ExclusiveSum(ctx.scratch(temp), temp, values, n, ctx.stream()),
                        "cub::DeviceScan::ExclusiveSum");
 }
 
@@ -123,9 +123,9 @@ inline void suffix_min(execution_context<cuda>& ctx, unsigned* values, std::size
     const thrust::reverse_iterator<unsigned*> last_first(values + n);
     const min_op op{};
     std::size_t temp = 0;
-    detail::check_cuda(cub::DeviceScan::InclusiveScan(nullptr, temp, last_first, last_first, op, n, cudaStream_t(0)),
+    detail::check_cuda(cub::DeviceScan::InclusiveScan(nullptr, temp, last_first, last_first, op, n, ctx.stream()),
                        "cub::DeviceScan::InclusiveScan (suffix minimum, size query)");
-    detail::check_cuda(cub::DeviceScan::InclusiveScan(ctx.scratch(temp), temp, last_first, last_first, op, n, cudaStream_t(0)),
+    detail::check_cuda(cub::DeviceScan::InclusiveScan(ctx.scratch(temp), temp, last_first, last_first, op, n, ctx.stream()),
                        "cub::DeviceScan::InclusiveScan (suffix minimum)");
 }
 #endif

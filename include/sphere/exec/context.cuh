@@ -8,8 +8,9 @@
 ///
 /// The host backend goes through the same calls, and both count what the CUDA build does in
 /// device_activity() (exec/activity.cuh): a scratch block that grows is an allocation, a
-/// read_back is a read-back. Kernels launch on the default stream on CUDA (as for_each_index
-/// does), so the context's calls are ordered with them.
+/// read_back is a read-back. On CUDA the context owns a stream: its reductions, sorts and
+/// scans run on it, and so do for_each_index's kernels while a `stream_scope` over the context
+/// lives (a simulation opens one in each call that launches work).
 #include <cstddef>
 #include <cstring>
 #include <utility>
@@ -31,6 +32,14 @@ namespace sphere {
 
 template <class Policy>
 class execution_context;
+
+/// Routes the kernels launched while it lives to a context's stream (CUDA); nothing on the
+/// host. A simulation opens one for each of its calls that launch work.
+template <class Policy>
+class stream_scope {
+public:
+    explicit stream_scope(execution_context<Policy>&) {}
+};
 
 /// Host: scratch in host memory; a read-back is a copy.
 template <>
@@ -87,6 +96,16 @@ public:
     {
         if (scratch_) cudaFree(scratch_);
         if (pinned_) cudaFreeHost(pinned_);
+        if (stream_) cudaStreamDestroy(stream_);
+    }
+
+    /// The context's own stream, made at its first use. A blocking stream: work on the
+    /// default stream (buffer allocations and copies, diagnostics outside a stream_scope)
+    /// stays ordered with it.
+    cudaStream_t stream()
+    {
+        if (!stream_) detail::check_cuda(cudaStreamCreate(&stream_), "cudaStreamCreate (context stream)");
+        return stream_;
     }
 
     void* scratch(std::size_t bytes)
@@ -114,8 +133,8 @@ public:
             detail::check_cuda(cudaMallocHost(&pinned_, bytes), "cudaMallocHost (context read-back)");
             pinned_bytes_ = bytes;
         }
-        detail::check_cuda(cudaMemcpyAsync(pinned_, from, bytes, cudaMemcpyDeviceToHost, 0), what);
-        const cudaError_t status = cudaStreamSynchronize(0);
+        detail::check_cuda(cudaMemcpyAsync(pinned_, from, bytes, cudaMemcpyDeviceToHost, stream()), what);
+        const cudaError_t status = cudaStreamSynchronize(stream());
         if (status != cudaSuccess)
             detail::fail("step ", step, ": CUDA error at ", what,
                          " (a kernel launched since the last read-back faulted, or the copy did): ",
@@ -130,18 +149,38 @@ private:
         std::swap(scratch_bytes_, other.scratch_bytes_);
         std::swap(pinned_, other.pinned_);
         std::swap(pinned_bytes_, other.pinned_bytes_);
+        std::swap(stream_, other.stream_);
     }
 
     void* scratch_ = nullptr;
     std::size_t scratch_bytes_ = 0;
     void* pinned_ = nullptr;
     std::size_t pinned_bytes_ = 0;
+    cudaStream_t stream_ = nullptr;
+};
+
+/// While it lives, the calling thread's kernels and CUB calls go to the context's stream
+/// (detail::current_stream); the stream before is restored after.
+template <>
+class stream_scope<cuda> {
+public:
+    explicit stream_scope(execution_context<cuda>& ctx) : before_(detail::current_stream())
+    {
+        detail::current_stream() = ctx.stream();
+    }
+    ~stream_scope() { detail::current_stream() = before_; }
+    stream_scope(const stream_scope&) = delete;
+    stream_scope& operator=(const stream_scope&) = delete;
+
+private:
+    cudaStream_t before_;
 };
 
 template <class T, class Transform, class Op>
 void transform_reduce_into(execution_context<cuda>& ctx, std::size_t n, const Transform& f, T init, Op op, T* out)
 {
     if (n == 0) {
+        const stream_scope<cuda> on_stream(ctx);
         for_each_index(cuda{}, 1, detail::fill_value<T>{out, init});
         return;
     }
@@ -150,13 +189,14 @@ void transform_reduce_into(execution_context<cuda>& ctx, std::size_t n, const Tr
     const std::size_t aligned = 256, value_bytes = (n * sizeof(T) + aligned - 1) / aligned * aligned;
     std::size_t bytes = 0;
     detail::check_cuda(cub::DeviceReduce::Reduce(nullptr, bytes, static_cast<const T*>(nullptr), out, n, op, init,
-                                                 cudaStream_t(0)),
+                                                 ctx.stream()),
                        "cub::DeviceReduce::Reduce (size query)");
     unsigned char* base = static_cast<unsigned char*>(ctx.scratch(value_bytes + bytes));
     T* values = reinterpret_cast<T*>(base);
+    const stream_scope<cuda> on_stream(ctx);
     for_each_index(cuda{}, n, detail::store_values<T, Transform>{f, values});
     detail::check_cuda(cub::DeviceReduce::Reduce(base + value_bytes, bytes, static_cast<const T*>(values), out, n, op,
-                                                 init, cudaStream_t(0)),
+                                                 init, ctx.stream()),
                        "cub::DeviceReduce::Reduce");
 }
 #endif

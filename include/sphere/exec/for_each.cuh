@@ -1,6 +1,7 @@
 #pragma once
 /// \file
-/// `for_each_index(policy, n, body)`: runs `body(i)` for every i in [0, n).
+/// `for_each_index(policy, n, body)`: runs `body(i)` for every i in [0, n) (on CUDA,
+/// asynchronously, on the calling thread's current stream).
 ///
 /// The body is a trivially copyable functor with a SPHERE_HD `operator()(std::size_t) const`
 /// (a kernel written once over views). Each index must write only its own outputs, so the
@@ -53,6 +54,14 @@ void for_each_index(host, std::size_t n, const Body& body)
 
 #if SPHERE_CUDA_COMPILER
 namespace detail {
+/// The stream the calling thread's CUDA work goes to: the simulation's own while one of its
+/// calls runs (stream_scope, exec/context.cuh), else the default stream.
+inline cudaStream_t& current_stream()
+{
+    static thread_local cudaStream_t stream = 0;
+    return stream;
+}
+
 template <class Body>
 __global__ void for_each_index_kernel(std::size_t n, Body body)
 {
@@ -69,7 +78,7 @@ void for_each_index(cuda, std::size_t n, const Body& body)
     constexpr unsigned threads = 256;
     const std::size_t wanted = (n + threads - 1) / threads;
     const unsigned blocks = static_cast<unsigned>(wanted < 65535u * 32u ? wanted : 65535u * 32u);
-    detail::for_each_index_kernel<<<blocks, threads>>>(n, body);
+    detail::for_each_index_kernel<<<blocks, threads, 0, detail::current_stream()>>>(n, body);
     detail::check_cuda(cudaGetLastError(), detail::kernel_name<Body>());
 }
 #endif

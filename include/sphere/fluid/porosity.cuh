@@ -218,6 +218,7 @@ public:
                              " m plus the largest particle radius ", r_max,
                              " m, so a particle could meet a cell sphere through two periodic images; use more fluid "
                              "cells along ", axis_name[a]);
+        const stream_scope<Policy> on_stream(context_);
         bins_.build(context_, p);
         detail::estimate_cell_porosity<Real> kernel{grid_, bins_.view(), p.v_sync, R, {0, 0, 0}, {0, 0, 0},
                                                     have_previous_, dt, phi_.data(), dphi_dt_.data(), v_p_.data(),
