@@ -8,7 +8,7 @@
 //   prescribed particle (whose drive power the step sums), on both pair schedules (the gather
 //   schedule is the one CUDA runs), with and without reordering the particles, with
 //   semi-implicit Euler and velocity Verlet, allocates nothing after warm-up and reads back
-//   exactly one struct;
+//   exactly one struct (velocity Verlet on the host-only slab schedule: two);
 // - a rebuild whose lists outgrow their capacity runs the step again with room, to the same
 //   bits as a run that had the room from the start.
 #include <catch2/catch.hpp>
@@ -121,7 +121,11 @@ void count_steps(sphere::pair_summation how, double skin, bool reorder)
     CHECK(sim.walls().face[5].force > 0); // the loads are in the report: the wall is pushed up,
     CHECK(sim.walls().face[4].force < 0); // the floor down (forces along the axis)
     CHECK(used.allocations == 0);
-    CHECK(used.read_backs == steps);
+    // Velocity Verlet on the host's slab schedule (which CUDA does not run) checks its drift in
+    // the drift's pass and reads that back too: a copy in memory there, cheaper than predicting
+    // it (docs/architecture.md, *Velocity Verlet, one read-back*).
+    const bool drift_read = Integrator::drifts_before_forces && how == sphere::pair_summation::slabs;
+    CHECK(used.read_backs == (drift_read ? 2 : 1) * steps);
 }
 
 TEMPLATE_TEST_CASE("device activity: a step allocates nothing after warm-up and reads back one struct, with or "
@@ -134,8 +138,8 @@ TEMPLATE_TEST_CASE("device activity: a step allocates nothing after warm-up and 
     // skin of 0: a rebuild before every step.
     const double skin = GENERATE(0.5, 0.0);
     SECTION("semi-implicit Euler") { count_steps<TestType, sphere::integrate::semi_implicit_euler>(how, skin, reorder); }
-    // its report also checks where the next drift puts the particles, so that the drift need
-    // not be checked and read back before the forces
+    // on the gather schedule its report also checks where the next drift puts the particles,
+    // so that the drift need not be checked and read back before the forces
     SECTION("velocity Verlet") { count_steps<TestType, sphere::integrate::velocity_verlet>(how, skin, reorder); }
 }
 

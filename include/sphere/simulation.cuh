@@ -196,7 +196,8 @@ struct simulation_state {
 /// observers that are due. Velocity Verlet drifts the particles first; its check at the end of
 /// a step is of the positions the next drift gives (docs/architecture.md, "One step"). A step
 /// reads back from the device once (twice when its rebuild outgrows the contact lists, which
-/// then grow, or after the host changed what velocity Verlet's drift reads).
+/// then grow, after the host changed what velocity Verlet's drift reads, and with velocity
+/// Verlet on the host's slab schedule, where a read-back is a copy in memory).
 template <class Precision, class Policy = host, class Law = contact::linear<>,
           class Integrator = integrate::semi_implicit_euler>
 class simulation {
@@ -631,16 +632,18 @@ private:
         do {
             if (rebuild) rebuild_lists(&report->lists);
             // the check at the end: of where the particles are, or of where the next drift puts them
-            const auto checks = [&] {
-                if constexpr (drifted) return detail::check_after_drift<Precision, Integrator, External>{drift, check()};
-                else return check();
-            }();
-            if constexpr (Book) {
-                const detail::both<detail::finish_audit<Precision>, decltype(integrate)> body{{p, Real(dt_)}, integrate};
-                finish_step<Book, Record>(body, checks, report);
-            } else {
-                finish_step<Book, Record>(integrate, checks, report);
-            }
+            const auto finish = [&](const auto& checks) {
+                if constexpr (Book) {
+                    const detail::both<detail::finish_audit<Precision>, decltype(integrate)> body{{p, Real(dt_)},
+                                                                                                   integrate};
+                    finish_step<Book, Record>(body, checks, report);
+                } else {
+                    finish_step<Book, Record>(integrate, checks, report);
+                }
+            };
+            if constexpr (!drifted) finish(check());
+            else if (predicts_drift()) finish(detail::check_after_drift<Precision, Integrator, External>{drift, check()});
+            else finish(detail::no_check<Coord>{});
             if constexpr (!drifted) turn(halt);
             if (drive_)
                 transform_reduce_into(context_, n,
@@ -657,7 +660,7 @@ private:
             // A bad particle after the next drift is left for that drift's own check to name;
             // a margin covers the rounding by which the drift may differ from the check's
             // copy of it (nvcc may contract them into different FMAs).
-            drift_checked_ = std::isfinite(done.moved2);
+            drift_checked_ = predicts_drift() && std::isfinite(done.moved2);
             if (drift_checked_) judge(done.moved2, steps_ + 1, drift_margin_);
         } else {
             judge(done.moved2, steps_);
@@ -695,6 +698,12 @@ private:
                               &report->loads);
         checked_into(detail::unless_halted<Body>{body, halt}, checks, &report->moved2);
     }
+
+    /// Whether velocity Verlet's step ends with the check of where its next drift puts the
+    /// particles (check_after_drift), to spare the drift's own read-back: on the gather schedule
+    /// (CUDA's). On the host's slab schedule a read-back is a copy in memory, and the drift's own
+    /// check, in the drift's pass, costs less than a second copy of its arithmetic.
+    bool predicts_drift() const { return summation_ == pair_summation::gather; }
 
     /// Advances the angular positions (settings.angular_position) with the angular velocities
     /// the step has just set, unless *halt (policy memory; detail::unless_halted).

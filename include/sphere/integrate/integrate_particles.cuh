@@ -25,20 +25,31 @@ namespace detail {
 /// particles (it cannot load a particle's fields conditionally in SIMD lanes). Forces are
 /// finite in any step the particle check lets through, so the zero scale gives exact zeros.
 template <bool External, class P, class Real = real_t<P>>
-SPHERE_HDI void accelerations(const particle_view<P>& p, std::size_t i, motion kind, const vec3<Real>& gravity,
-                              const vec3<Real>* external, vec3<Real>& a, vec3<Real>& alpha)
+SPHERE_HDI vec3<Real> linear_acceleration(const particle_view<P>& p, std::size_t i, motion kind,
+                                          const vec3<Real>& gravity, const vec3<Real>* external)
 {
-    const Real m = p.mass[i], r = Real(p.x[i].w);
+    const Real m = p.mass[i];
     vec3<Real> contact = p.force[i], total = contact; // not const: see the note in contact/evaluate.cuh
     if constexpr (External) total += external[i];
     const bool free = kind == motion::free, horizontal = kind == motion::prescribed_horizontal;
     const Real inv_m = Real(1) / m;
     const Real free_scale = free ? inv_m : Real(0);
     const Real z_scale = free || horizontal ? inv_m : Real(0);
+    vec3<Real> a;
     a.x = total.x * free_scale + (free ? gravity.x : Real(0));
     a.y = total.y * free_scale + (free ? gravity.y : Real(0));
     a.z = (free ? total.z : contact.z) * z_scale + (free ? gravity.z : Real(0));
-    alpha = p.torque[i] * (free ? Real(1) / (Real(0.4) * m * r * r) : Real(0));
+    return a;
+}
+
+/// linear_acceleration and the angular acceleration (rad/s^2).
+template <bool External, class P, class Real = real_t<P>>
+SPHERE_HDI void accelerations(const particle_view<P>& p, std::size_t i, motion kind, const vec3<Real>& gravity,
+                              const vec3<Real>* external, vec3<Real>& a, vec3<Real>& alpha)
+{
+    a = linear_acceleration<External>(p, i, kind, gravity, external);
+    const Real m = p.mass[i], r = Real(p.x[i].w);
+    alpha = p.torque[i] * (kind == motion::free ? Real(1) / (Real(0.4) * m * r * r) : Real(0));
 }
 
 /// Advances particle i by dt after the forces: free particles with the integrator policy,
@@ -100,27 +111,26 @@ struct drift_particles {
     Real dt;
     const vec3<Real>* external; ///< external force on each particle (N), read with External
 
-    /// Particle i's position (wrapped), velocity and angular velocity after the drift, from
-    /// its fields now; nothing is stored.
-    SPHERE_HDI void drifted(std::size_t i, vec3<Coord>& pos, vec3<Real>& v, vec3<Real>& w) const
+    /// Particle i's position (wrapped) and velocity after the drift, from its fields now;
+    /// nothing is stored (check_after_drift needs no more).
+    SPHERE_HDI void drifted(std::size_t i, vec3<Coord>& pos, vec3<Real>& v) const
     {
         static_assert(!Integrator::distinct_synchronous_velocity, "a drifting integrator keeps one velocity");
-        const auto kind = static_cast<motion>(p.kind[i]);
         pos = p.x[i].xyz();
         v = p.v[i];
-        w = p.omega[i];
-        vec3<Real> angle{0, 0, 0}, a, alpha; // angles are turn_particles' (not stored here)
-        accelerations<External>(p, i, kind, gravity, external, a, alpha);
+        const vec3<Real> a = linear_acceleration<External>(p, i, static_cast<motion>(p.kind[i]), gravity, external);
         Integrator::drift(pos, v, a, dt);
-        Integrator::drift(angle, w, alpha, dt);
         pos = box.wrap(pos);
     }
 
     SPHERE_HDI void operator()(std::size_t i) const
     {
         vec3<Coord> pos;
-        vec3<Real> v, w;
-        drifted(i, pos, v, w);
+        vec3<Real> v;
+        drifted(i, pos, v);
+        vec3<Real> w = p.omega[i], angle{0, 0, 0}, a, alpha; // angles are turn_particles' (not stored here)
+        accelerations<External>(p, i, static_cast<motion>(p.kind[i]), gravity, external, a, alpha);
+        Integrator::drift(angle, w, alpha, dt);
         p.x[i] = {pos.x, pos.y, pos.z, p.x[i].w};
         p.v[i] = v;
         p.omega[i] = w;
@@ -191,8 +201,8 @@ struct check_after_drift {
     SPHERE_HDI coord_t<P> operator()(std::size_t i) const
     {
         vec3<coord_t<P>> pos;
-        vec3<real_t<P>> v, w;
-        drift.drifted(i, pos, v, w);
+        vec3<real_t<P>> v;
+        drift.drifted(i, pos, v);
         return check.at(i, pos);
     }
 };
@@ -205,8 +215,15 @@ struct bad_particle {
     SPHERE_HD std::size_t operator()(std::size_t i) const { return check.bad(i) ? std::size_t(check.p.user[i]) : ~std::size_t(0); }
 };
 
+/// No check: 0 for every particle (velocity Verlet on the host's slab schedule, whose drift
+/// checks the particles itself).
+template <class Coord>
+struct no_check {
+    SPHERE_HDI Coord operator()(std::size_t) const { return Coord(0); }
+};
+
 /// Runs a particle kernel `body` on particle i, then returns the particle check `Check`
-/// (check_particle or check_after_drift; kernel body of a transform_reduce: one parallel pass
+/// (check_particle, check_after_drift or no_check; kernel body of a transform_reduce: one parallel pass
 /// instead of two).
 template <class Body, class Check>
 struct then_check {
