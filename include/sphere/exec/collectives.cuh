@@ -8,7 +8,6 @@
 /// its array's last element, for the kernels that follow to read).
 #include <cstddef>
 #include <cstring>
-#include <utility>
 
 #include "../core/config.cuh"
 #include "context.cuh"
@@ -23,12 +22,6 @@
 #endif
 
 namespace sphere {
-
-namespace detail {
-/// `bytes` rounded up to a multiple of 256, so that arrays placed one after the other in a
-/// scratch block stay aligned for any type.
-inline std::size_t aligned_bytes(std::size_t bytes) { return (bytes + 255) / 256 * 256; }
-} // namespace detail
 
 /// Sorts keys[0, n) ascending by their bits [0, bits) and applies the same permutation to
 /// `values`; stable, so equal keys keep their order and results are deterministic. On the

@@ -33,6 +33,12 @@ namespace sphere {
 template <class Policy>
 class execution_context;
 
+namespace detail {
+/// `bytes` rounded up to a multiple of 256, so that arrays placed one after the other in a
+/// scratch block stay aligned for any type.
+inline std::size_t aligned_bytes(std::size_t bytes) { return (bytes + 255) / 256 * 256; }
+} // namespace detail
+
 /// Routes the kernels launched while it lives to a context's stream (CUDA); nothing on the
 /// host. A simulation opens one for each of its calls that launch work.
 template <class Policy>
@@ -186,7 +192,7 @@ void transform_reduce_into(execution_context<cuda>& ctx, std::size_t n, const Tr
     }
     // The transform runs in a kernel of its own, one index per thread, into the scratch; CUB
     // then reduces the plain array (see transform_reduce in exec/algorithms.cuh).
-    const std::size_t aligned = 256, value_bytes = (n * sizeof(T) + aligned - 1) / aligned * aligned;
+    const std::size_t value_bytes = detail::aligned_bytes(n * sizeof(T));
     std::size_t bytes = 0;
     detail::check_cuda(cub::DeviceReduce::Reduce(nullptr, bytes, static_cast<const T*>(nullptr), out, n, op, init,
                                                  ctx.stream()),

@@ -170,10 +170,7 @@ public:
     void permute(const unsigned* order, const vec4<Coord>* sorted_x, Along&... along)
     {
         for_each_index(Policy{}, x_.size(), detail::copy_back<vec4<Coord>>{sorted_x, x_.data()});
-        each_carried_field([&](auto& field) { permute_field(field, order); });
-        permute_field(user_, order);
-        (permute_field(along, order), ...);
-        for_each_index(Policy{}, force_.size(), detail::fill_value<vec3<Real>>{force_.data(), {0, 0, 0}});
+        move_fields<detail::gather>(order, along...);
     }
 
     /// Undoes permute(order, sorted_x, along...): every particle and `along` array back into
@@ -183,10 +180,7 @@ public:
     void unpermute(const unsigned* order, const vec4<Coord>* sorted_x, Along&... along)
     {
         for_each_index(Policy{}, x_.size(), detail::scatter<vec4<Coord>>{sorted_x, order, x_.data()});
-        each_carried_field([&](auto& field) { unpermute_field(field, order); });
-        unpermute_field(user_, order);
-        (unpermute_field(along, order), ...);
-        for_each_index(Policy{}, force_.size(), detail::fill_value<vec3<Real>>{force_.data(), {0, 0, 0}});
+        move_fields<detail::scatter>(order, along...);
     }
 
     /// Sets which particle each slot holds (user index per slot), e.g. for a restart; the
@@ -262,26 +256,26 @@ private:
         f(mass_); f(pressure_); f(e_visc_); f(e_fric_); f(p_visc_); f(p_fric_); f(kind_);
     }
 
-    /// Gathers one field into the forces' array and copies it back.
-    template <class T>
-    void permute_field(buffer<T, Policy>& field, const unsigned* order)
+    /// Moves every carried field, the user indices and the `along` arrays through `order` by
+    /// `Move` (detail::gather for permute, detail::scatter to undo it), each by way of the
+    /// forces' array, which holds zeros afterwards.
+    template <template <class> class Move, class... Along>
+    void move_fields(const unsigned* order, Along&... along)
     {
-        static_assert(sizeof(T) <= sizeof(vec3<Real>) && alignof(T) <= alignof(vec3<Real>), "scratch too narrow");
-        T* tmp = reinterpret_cast<T*>(force_.data());
-        const std::size_t n = field.size();
-        for_each_index(Policy{}, n, detail::gather<T>{field.data(), order, tmp});
-        for_each_index(Policy{}, n, detail::copy_back<T>{tmp, field.data()});
+        each_carried_field([&](auto& field) { move_field<Move>(field, order); });
+        move_field<Move>(user_, order);
+        (move_field<Move>(along, order), ...);
+        for_each_index(Policy{}, force_.size(), detail::fill_value<vec3<Real>>{force_.data(), {0, 0, 0}});
     }
 
-    /// Scatters one field back through `order` (the inverse of permute_field), by way of the
-    /// forces' array.
-    template <class T>
-    void unpermute_field(buffer<T, Policy>& field, const unsigned* order)
+    /// Moves one field through `order` by `Move` into the forces' array and copies it back.
+    template <template <class> class Move, class T>
+    void move_field(buffer<T, Policy>& field, const unsigned* order)
     {
         static_assert(sizeof(T) <= sizeof(vec3<Real>) && alignof(T) <= alignof(vec3<Real>), "scratch too narrow");
         T* tmp = reinterpret_cast<T*>(force_.data());
         const std::size_t n = field.size();
-        for_each_index(Policy{}, n, detail::scatter<T>{field.data(), order, tmp});
+        for_each_index(Policy{}, n, Move<T>{field.data(), order, tmp});
         for_each_index(Policy{}, n, detail::copy_back<T>{tmp, field.data()});
     }
 
