@@ -10,13 +10,18 @@
 //   semi-implicit Euler and velocity Verlet, allocates nothing after warm-up and reads back
 //   exactly one struct (velocity Verlet on the host-only slab schedule: two);
 // - a rebuild whose lists outgrow their capacity runs the step again with room, to the same
-//   bits as a run that had the room from the start.
+//   bits as a run that had the room from the start; a rebuild whose entries pass 2^32 - 1
+//   (what the lists' 32-bit offsets hold) is found on the device and reported as an error;
+// - a pressure solve reads its control back once when it needs no more passes than the last
+//   one and a quarter; a fluid step (with either solver) reads back once and allocates
+//   nothing after warm-up; a coupled step reads back once more than its DEM steps do.
 #include <catch2/catch.hpp>
 
 #include <random>
 #include <vector>
 
 #include <sphere/dem.cuh>
+#include <sphere/fluid.cuh>
 
 #include "support.hpp"
 
@@ -188,4 +193,125 @@ TEMPLATE_TEST_CASE("contact lists that outgrow their capacity run the step again
     for (std::size_t e = 0; e < ca.history.size(); ++e)
         histories_differ += !(ca.history[e].xyz() == cb.history[e].xyz()) || ca.history[e].w != cb.history[e].w;
     CHECK(histories_differ == 0);
+}
+
+TEMPLATE_TEST_CASE("device activity: a pressure solve reads its control back once, more only past its budget",
+                   "[activity][fluid]", float, double)
+{
+    using Real = TestType;
+    const sphere::fluid_grid<Real> g = sphere::fluid_grid<Real>::make(
+        sphere::world<Real>{{0, 0, 0}, {Real(0.016), Real(0.016), Real(0.032)}}, 16, 16, 32);
+    std::vector<Real> rhs(g.field_size(), Real(0)), eps(g.field_size(), Real(0));
+    for (std::size_t c = 0; c < rhs.size(); ++c) rhs[c] = Real(std::sin(0.37 * double(c)) * 1e3);
+    sphere::buffer<Real, sphere::host> b(rhs.size()), e(eps.size());
+    b.assign(rhs);
+    sphere::poisson_settings st;
+    st.tolerance = sizeof(Real) == 8 ? 1e-8 : 1e-3;
+    const sphere::poisson_boundaries bc{sphere::z_boundary::neumann, sphere::z_boundary::dirichlet};
+    sphere::cg_poisson<Real, sphere::host> cg(g);
+    sphere::jacobi_poisson<Real, sphere::host> jacobi(g);
+    // The first solves start from 16 passes and double until they finish: several read-backs.
+    e.assign(eps);
+    sphere::device_activity_counts start = sphere::device_activity();
+    const sphere::poisson_result first = cg.solve(e.data(), b.data(), bc, st);
+    REQUIRE(first.converged);
+    CHECK(first.iterations > 32u);
+    CHECK(since(start).read_backs > 1);
+    e.assign(eps);
+    jacobi.solve(e.data(), b.data(), bc, st); // warms the Jacobi solver's scratch
+    // The same solve again fits the budget the first one left: one read-back, no allocation.
+    for (int solver = 0; solver < 2; ++solver) {
+        CAPTURE(solver);
+        e.assign(eps);
+        start = sphere::device_activity();
+        const sphere::poisson_result again =
+            solver == 0 ? cg.solve(e.data(), b.data(), bc, st) : jacobi.solve(e.data(), b.data(), bc, st);
+        CHECK(again.converged);
+        CHECK(since(start).read_backs == 1);
+        CHECK(since(start).allocations == 0);
+    }
+}
+
+namespace {
+
+/// A sphere settling in a periodic fluid column (VALIDATION F6's set-up) with a pressure top;
+/// counts the read-backs of a fluid step alone, of dem_steps DEM steps and of a coupled step.
+template <class Real, class Poisson>
+void count_coupled_step()
+{
+    const double cell = 5e-3;
+    sphere::settings<Real> s;
+    s.box.lo = {0, 0, 0};
+    s.box.hi = {Real(4 * cell), Real(4 * cell), Real(40 * cell)};
+    s.box.axis[0] = s.box.axis[1] = sphere::boundary::periodic;
+    s.contact.k_n = s.wall.k_n = s.contact.k_t = s.wall.k_t = Real(100);
+    s.gravity = {0, 0, Real(-9.81)};
+    sphere::particle<Real> p;
+    p.position = {Real(1.5 * cell), Real(1.5 * cell), Real(34.5 * cell)};
+    p.radius = Real(5e-4);
+    p.density = 2600;
+    sphere::simulation<Real, sphere::host> sim(s, {p});
+    sphere::fluid_params<Real> prm;
+    prm.viscosity = Real(0.1);
+    prm.gravity = s.gravity;
+    prm.top = sphere::fluid_boundary<Real>::prescribed_pressure(0);
+    prm.poisson.tolerance = sizeof(Real) == 8 ? 1e-10 : 1e-3; // float's round-off floor: docs/fluid.md
+    sphere::coupling_options opt;
+    opt.dem_steps = 20;
+    sphere::fluid_coupling<Real, sphere::host, sphere::drag::gidaspow, Poisson> coupled(
+        sphere::fluid_grid<Real>::make(s.box, 4, 4, 40), prm, opt);
+    for (int k = 0; k < 5; ++k) coupled.step(sim); // warm-up: buffers, scratch, the solver's budget
+
+    sphere::device_activity_counts start = sphere::device_activity();
+    sim.run(opt.dem_steps);
+    const sphere::device_activity_counts dem = since(start);
+    start = sphere::device_activity();
+    coupled.step(sim);
+    const sphere::device_activity_counts step = since(start);
+    INFO("DEM steps: " << dem.read_backs << " read-backs; coupled step: " << step.read_backs << ", "
+                       << step.allocations << " allocations; pressure solve: "
+                       << coupled.fluid().last_solve().iterations << " iterations");
+    CHECK(coupled.fluid().last_solve().iterations > 0u);
+    CHECK(dem.read_backs == opt.dem_steps);
+    CHECK(step.read_backs == dem.read_backs + 1);
+    CHECK(step.allocations == 0);
+
+    // The fluid on its own (after two steps that set its solver's budget for this problem).
+    const Real dt = Real(opt.dem_steps) * sim.dt();
+    coupled.fluid().step(dt);
+    coupled.fluid().step(dt);
+    start = sphere::device_activity();
+    coupled.fluid().step(dt);
+    CHECK(since(start).read_backs == 1);
+    CHECK(since(start).allocations == 0);
+}
+
+} // namespace
+
+TEMPLATE_TEST_CASE("device activity: a fluid step reads back once, a coupled step once more than its DEM steps",
+                   "[activity][fluid]", float, double)
+{
+    using Real = TestType;
+    SECTION("conjugate gradients") { count_coupled_step<Real, sphere::cg_poisson<Real, sphere::host>>(); }
+    SECTION("Jacobi") { count_coupled_step<Real, sphere::jacobi_poisson<Real, sphere::host>>(); }
+}
+
+TEST_CASE("device activity: a rebuild whose entries wrap the 32-bit offsets is an error", "[activity]")
+{
+    // The rows' offsets as the scan leaves them when the counts pass 2^32 - 1: a row ends
+    // below its start.
+    const std::vector<unsigned> wrapped{0, 4000000000u, 4294967295u, 5u, 9u};
+    const std::vector<unsigned> whole{0, 4000000000u, 4294967295u, 4294967295u};
+    const auto wraps = [](const std::vector<unsigned>& offsets) {
+        sphere::buffer<unsigned, sphere::host> o(offsets.size());
+        o.assign(offsets);
+        return sphere::transform_reduce(sphere::host{}, offsets.size() - 1, sphere::detail::row_wraps{o.data()}, 0u,
+                                        sphere::max_op{});
+    };
+    CHECK(wraps(wrapped) == 1u);
+    CHECK(wraps(whole) == 0u);
+    sphere::contact_lists<double, sphere::host> lists(4, false);
+    sphere::list_totals t;
+    t.overflow = t.wrapped = 1;
+    CHECK_THROWS_WITH(lists.settle(t), Catch::Contains("more than 4294967295 contact entries"));
 }

@@ -201,6 +201,20 @@ TEMPLATE_TEST_CASE("the fluid solver refuses unstable time steps, unconverged so
     hard.poisson.max_iterations = 2;
     sphere::navier_stokes<Real, sphere::host> limited(g, hard);
     CHECK_THROWS_WITH(limited.step(Real(1e-3)), Catch::Contains("did not converge") && Catch::Contains("after 2 iterations"));
+    CHECK(limited.time() == 0.0);
+
+    // A porosity outside (0, 1] is found by the next step (set_porosity reads nothing back),
+    // and that step advances nothing: the velocity field stays as it was set.
+    sphere::navier_stokes<Real, sphere::host> porous(g, sphere::fluid_params<Real>{});
+    porous.set_velocity([](const vec3<Real>&) { return vec3<Real>{Real(1e-3), 0, 0}; });
+    std::vector<Real> phi(g.field_size(), Real(0.5)), rate(g.field_size(), Real(0)), d(g.field_size(), Real(0));
+    std::vector<vec3<Real>> v(g.field_size(), vec3<Real>{0, 0, 0});
+    phi[g.field_index(2, 1, 7)] = Real(0);
+    porous.set_porosity(sphere::porosity_view<Real>{g, Real(0.05), phi.data(), rate.data(), v.data(), d.data()});
+    const std::vector<Real> u_before = porous.face_velocity(0);
+    CHECK_THROWS_WITH(porous.step(Real(1e-3)), Catch::Contains("a cell has porosity 0"));
+    CHECK(porous.face_velocity(0) == u_before);
+    CHECK(porous.time() == 0.0);
 
     sphere::fluid_params<Real> bad;
     bad.viscosity = Real(-1);

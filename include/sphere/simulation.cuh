@@ -243,6 +243,7 @@ public:
             min_mass = i == 0 || m < min_mass ? m : min_mass;
             max_radius = p.radius > max_radius ? p.radius : max_radius;
         }
+        largest_radius_ = max_radius;
         const Coord bound = stable_time_step_bound(min_mass, s.contact, s.wall);
         if (s.dt == Coord(0)) {
             dt_ = default_time_step(min_mass, s.contact, s.wall);
@@ -370,6 +371,9 @@ public:
 
     std::size_t size() const { return particles_.size(); }
     Coord dt() const { return dt_; }
+    /// The largest particle radius (m), known on the host (the pore-fluid coupling's cell
+    /// search reach, read without asking the device).
+    Coord largest_radius() const { return largest_radius_; }
     /// Simulated time (s), steps() * dt() in double.
     double time() const { return time_; }
     std::size_t steps() const { return steps_; }
@@ -508,11 +512,13 @@ public:
             if (kinds_[i] == motion::fixed) // a fixed particle has no velocity (motion::fixed)
                 restored.v[i] = restored.omega[i] = restored.v_sync[i] = restored.omega_sync[i] = vec3<Coord>{0, 0, 0};
         particles_.restore(restored);
+        largest_radius_ = 0;
+        for (const vec4<Coord>& x : restored.x) largest_radius_ = x.w > largest_radius_ ? x.w : largest_radius_;
         lists_.restore(s.contacts, g, !settings_.reorder);
         interaction_.lists_changed();
         wall_launch_ = lists_.wall_particles();
         detail::step_report<Coord> fresh{};
-        fresh.lists = {0, unsigned(lists_.entries()), unsigned(wall_launch_), 0};
+        fresh.lists = {0, unsigned(lists_.entries()), unsigned(wall_launch_), 0, 0};
         report_.assign(std::vector<detail::step_report<Coord>>{fresh});
         std::vector<vec4<Coord>> slots(size());
         for (std::size_t k = 0; k < size(); ++k) slots[k] = s.x_at_build[storage[k]];
@@ -821,6 +827,7 @@ private:
     contact_params<Real> pair_params_, wall_params_; ///< settings_.contact and .wall in the laws' precision
     vec3<Real> gravity_;                             ///< settings_.gravity in the particles' precision
     Coord dt_ = 0;
+    Coord largest_radius_ = 0; ///< largest_radius()
     double time_ = 0;
     double drive_work_ = 0; ///< work done on the prescribed particles so far (J)
     std::size_t steps_ = 0, rebuilds_ = 0;

@@ -49,12 +49,14 @@ inline constexpr unsigned no_rank = 0xFFFFFFFFu;
 /// entries whose history it carried over, the entries of the new lists, the particles with
 /// wall entries, and whether the first two exceeded the capacities the lists had. After an
 /// overflow the new lists are empty and contact_lists::settle grows them for the rebuild to
-/// run again.
+/// run again. `wrapped`: the entries exceeded what 32-bit offsets hold (an overflow too,
+/// which settle reports as an error).
 struct list_totals {
     unsigned kept = 0;
     unsigned entries = 0;
     unsigned wall_particles = 0;
     unsigned overflow = 0;
+    unsigned wrapped = 0;
 };
 
 /// A contact's history or recorded force as seen from its other particle: the tangential part
@@ -400,8 +402,15 @@ struct copy_histories {
     }
 };
 
+/// 1 where the scan of the rows' entry counts wrapped around 2^32 at row r (its end lies
+/// below its start), else 0. Reduced with max: whether any row did.
+struct row_wraps {
+    const unsigned* offset;
+    SPHERE_HD unsigned operator()(std::size_t r) const { return offset[r + 1] < offset[r] ? 1u : 0u; }
+};
+
 /// Writes the totals of a rebuild from its scans (kept entries, new entries) and whether they
-/// exceed the capacities.
+/// exceed the capacities (totals->wrapped, found before, counts as exceeding them).
 struct record_totals {
     const unsigned* kept_offset;
     const unsigned* offset;
@@ -412,7 +421,7 @@ struct record_totals {
         totals->kept = kept_offset[n];
         totals->entries = offset[n];
         totals->wall_particles = 0;
-        totals->overflow = kept_offset[n] > kept_capacity || offset[n] > entry_capacity;
+        totals->overflow = kept_offset[n] > kept_capacity || offset[n] > entry_capacity || totals->wrapped;
     }
 };
 
@@ -529,6 +538,8 @@ public:
         for_each_index(Policy{}, n, detail::count_entries<Coord>{scan, offset});
         for_each_index(Policy{}, 1, detail::fill_value<unsigned>{offset + n, 0u});
         exclusive_scan(ctx, offset, n + 1);
+        // The kept entries are at most the old lists' entries: only the new ones can wrap.
+        transform_reduce_into(ctx, n, detail::row_wraps{offset}, 0u, max_op{}, &totals->wrapped);
         for_each_index(Policy{}, 1,
                        detail::record_totals{kept_offset_.data(), offset, n, kept_capacity(), capacity(), totals});
         const detail::old_lists<Real> old{kept_offset_.data(), kept_partner_.data(), kept_history_.view()};
@@ -573,6 +584,9 @@ public:
     /// again.
     bool settle(const list_totals& t, bool headroom = true)
     {
+        if (t.wrapped)
+            detail::fail("contact lists: a rebuild found more than 4294967295 contact entries, more than their 32-bit "
+                         "offsets hold; use a smaller skin or fewer particles per simulation");
         if (!t.overflow) {
             entries_ = t.entries;
             wall_particles_ = t.wall_particles;

@@ -52,6 +52,16 @@ void for_each_index(host, std::size_t n, const Body& body)
     }
 }
 
+/// body(i) for every i in [0, n) if `*go` is not 0 when the loop's turn comes: `go` lies in the
+/// policy's memory and may be set by a kernel launched before (a decision taken on the device,
+/// which the host does not wait for). The host reads the flag once before the loop; each CUDA
+/// thread reads it first.
+template <class Body>
+void for_each_index_if(host, const int* go, std::size_t n, const Body& body)
+{
+    if (*go) for_each_index(host{}, n, body);
+}
+
 #if SPHERE_CUDA_COMPILER
 namespace detail {
 /// The stream the calling thread's CUDA work goes to: the simulation's own while one of its
@@ -80,6 +90,25 @@ void for_each_index(cuda, std::size_t n, const Body& body)
     const unsigned blocks = static_cast<unsigned>(wanted < 65535u * 32u ? wanted : 65535u * 32u);
     detail::for_each_index_kernel<<<blocks, threads, 0, detail::current_stream()>>>(n, body);
     detail::check_cuda(cudaGetLastError(), detail::kernel_name<Body>());
+}
+
+namespace detail {
+/// body(i) where *go is not 0 (for_each_index_if on CUDA).
+template <class Body>
+struct only_if {
+    const int* go;
+    Body body;
+    SPHERE_HD void operator()(std::size_t i) const
+    {
+        if (*go) body(i);
+    }
+};
+} // namespace detail
+
+template <class Body>
+void for_each_index_if(cuda, const int* go, std::size_t n, const Body& body)
+{
+    for_each_index(cuda{}, n, detail::only_if<Body>{go, body});
 }
 #endif
 

@@ -16,6 +16,9 @@
 ///   4. the fluid advances by dt_f (its own stability limits checked), then the DEM by
 ///      dem_steps steps with the forces held constant; the work the forces did on the free
 ///      particles (force times displacement) is added to work_on_particles().
+/// The checks (porosity, response time, stability, the pressure solve) are taken on the device
+/// and read back once, with the fluid step's report, before the DEM steps: a coupled step
+/// waits for the device once more than its dem_steps DEM steps do.
 /// The forces are explicit: dt_f must not exceed the shortest particle response time
 /// m_i / (beta_per_solid V_i) (checked; the step throws naming the particle).
 #include <cstddef>
@@ -130,6 +133,13 @@ struct fluid_work_on_particle {
     }
 };
 
+/// Adds the last coupled step's work to the total (in the fluid's report).
+template <class Real>
+struct add_work {
+    fluid_report<Real>* r;
+    SPHERE_HD void operator()(std::size_t) const { r->work_total += r->work_step; }
+};
+
 } // namespace detail
 
 /// The pore fluid coupled to a simulation's particles. `Drag` is a drag law of sphere::drag,
@@ -160,36 +170,45 @@ public:
                       "coupled to the pore fluid yet (docs/fluid.md)");
         const Real dt = Real(options_.dem_steps) * sim.dt();
         const particle_view<Real> p = sim.particle_data();
-        porosity_.update(p, dt);
+        porosity_.update(p, dt, sim.largest_radius());
         fluid_.set_porosity(porosity_.view());
         vec3<Real>* forces = sim.external_forces();
         if (response_.size() != p.n) response_ = buffer<Real, Policy>(p.n);
         for_each_index(Policy{}, p.n,
                        detail::fluid_particle_force<Real, Drag>{fluid_.view(), porosity_.view(), p, forces,
                                                                 response_.data(), options_.pressure_force});
-        const Real response =
-            transform_reduce(Policy{}, p.n, detail::value_at<Real>{response_.data()}, Real(1e30), min_op{});
-        if (!(dt <= response))
-            detail::fail("coupling: the fluid step ", dt, " s (", options_.dem_steps, " DEM steps of ", sim.dt(),
-                         " s) exceeds the shortest particle response time m / (drag coefficient) = ", response,
-                         " s; use fewer DEM steps per fluid step");
+        detail::fluid_report<Real>* report = fluid_.report();
+        transform_reduce_into(fluid_.context(), p.n, detail::value_at<Real>{response_.data()}, Real(1e30), min_op{},
+                              &report->response);
         for_each_index(Policy{}, fluid_.grid().cell_count(),
                        detail::fluid_reaction<Real>{fluid_.view(), porosity_.bins(), forces});
-        fluid_.step(dt);
+        const detail::fluid_report<Real>& found = fluid_.advance(dt);
+        if (found.hold == detail::fluid_hold_response)
+            detail::fail("coupling: the fluid step ", dt, " s (", options_.dem_steps, " DEM steps of ", sim.dt(),
+                         " s) exceeds the shortest particle response time m / (drag coefficient) = ", found.response,
+                         " s; use fewer DEM steps per fluid step");
+        fluid_.check(found, dt);
         if (x_before_.size() != p.n) x_before_ = buffer<vec4<Real>, Policy>(p.n);
         for_each_index(Policy{}, p.n, detail::positions_by_user<Real>{p, x_before_.data()});
         sim.run(options_.dem_steps);
-        work_ += transform_reduce(
-            Policy{}, p.n,
+        transform_reduce_into(
+            fluid_.context(), p.n,
             detail::fluid_work_on_particle<Real>{sim.config().box, x_before_.data(), sim.particle_data(), forces}, 0.0,
-            plus_op{});
+            plus_op{}, &report->work_step);
+        for_each_index(Policy{}, 1, detail::add_work<Real>{report});
     }
 
     /// Work done by the fluid on the free particles so far (J): the sum over coupled steps of
     /// each particle's fluid force times its displacement in that step (exact for forces held
     /// constant over the step). With it the particles' energy budget closes:
-    /// sim.energy().total() - its initial value = work_on_particles().
-    double work_on_particles() const { return work_; }
+    /// sim.energy().total() - its initial value = work_on_particles(). The sum is kept on the
+    /// device: this reads it back.
+    double work_on_particles()
+    {
+        detail::fluid_report<Real> r;
+        fluid_.context().read_back(&r, fluid_.report(), 1, "the coupling's work on the particles", 0);
+        return r.work_total;
+    }
 
 private:
     coupling_options options_;
@@ -197,7 +216,6 @@ private:
     navier_stokes<Real, Policy, Poisson> fluid_;
     buffer<vec4<Real>, Policy> x_before_;  ///< positions at the start of the DEM steps, by user index
     buffer<Real, Policy> response_;        ///< each particle's response time to the drag (s)
-    double work_ = 0;                      ///< work_on_particles() (J)
 };
 
 } // namespace sphere

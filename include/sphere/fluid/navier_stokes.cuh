@@ -17,6 +17,7 @@
 #include "../core/vec.cuh"
 #include "../exec/algorithms.cuh"
 #include "../exec/buffer.cuh"
+#include "../exec/context.cuh"
 #include "../exec/for_each.cuh"
 #include "fluid_params.cuh"
 #include "grid.cuh"
@@ -335,6 +336,59 @@ struct face_momentum {
     }
 };
 
+/// Why a fluid step held (did not advance): fluid_report::hold.
+enum fluid_hold : int {
+    fluid_advances = 0,
+    fluid_hold_porosity = 1, ///< a cell's porosity is not in (0, 1]
+    fluid_hold_response = 2, ///< dt exceeds the shortest particle response time (the coupling's)
+    fluid_hold_stability = 3, ///< dt exceeds the stability limit
+};
+
+/// What a fluid step found, in the policy's memory; the step reads it back once, at its end
+/// (docs/fluid.md, *Solves without waiting*).
+template <class Real>
+struct fluid_report {
+    poisson_control solve;
+    Real lowest_porosity; ///< the smallest cell porosity set_porosity was given
+    Real response;        ///< the shortest particle response time (s) the coupling wrote (1e30 alone)
+    Real phi_min, rate;   ///< the stability limit's reductions: least porosity, largest advective rate (1/s)
+    Real limit;           ///< the stability limit (s)
+    int hold;             ///< fluid_hold
+    int commit;           ///< the solve converged and nothing held: the fields advance
+    double work_step;     ///< the coupling's: the fluid's work on the particles in the last step (J)
+    double work_total;    ///< and its sum (J)
+};
+
+/// The checks before a fluid step of length dt: the stability limit from the reductions, and
+/// why the step holds, if it does (the first failing check, in fluid_hold's order).
+template <class Real>
+struct fluid_precheck {
+    fluid_report<Real>* r;
+    Real dt, density, viscosity, inv_h2;
+
+    SPHERE_HD void operator()(std::size_t) const
+    {
+        Real limit = r->phi_min * density / (Real(2) * viscosity * inv_h2);
+        if (r->rate > 0 && Real(1) / r->rate < limit) limit = Real(1) / r->rate;
+        r->limit = limit;
+        r->hold = !(r->lowest_porosity > Real(0)) ? fluid_hold_porosity
+                  : !(dt <= r->response)          ? fluid_hold_response
+                  : !(dt <= limit)                ? fluid_hold_stability
+                                                  : fluid_advances;
+        r->commit = 0;
+    }
+};
+
+/// Whether the step's fields advance: the solve is over, converged, and nothing held.
+template <class Real>
+struct fluid_commit {
+    fluid_report<Real>* r;
+    SPHERE_HD void operator()(std::size_t) const
+    {
+        r->commit = r->solve.finishing && r->solve.converged && r->hold == fluid_advances;
+    }
+};
+
 } // namespace detail
 
 /// The pore-fluid solver. `Poisson` is the pressure solver: cg_poisson (default; conjugate
@@ -342,17 +396,25 @@ struct face_momentum {
 ///
 /// Each `step(dt)` advances the fluid from t to t + dt with the porosity, its rate and the
 /// interaction force it was last given (set_porosity, interaction_force): a fluid on its own
-/// has phi = 1 and no force. The step throws sphere::error, before changing any field, when
-/// dt is not positive, when dt exceeds the diffusive limit dt <= phi_min rho / (2 mu sum 1/h^2)
-/// or the advective limit dt max(|v_x|/dx + |v_y|/dy + |v_z|/dz) <= 1, and after the pressure
-/// solve when it did not converge within the iteration limit.
+/// has phi = 1 and no force. The step throws sphere::error, with no field advanced, when dt is
+/// not positive, when a cell's porosity is not in (0, 1], when dt exceeds the diffusive limit
+/// dt <= phi_min rho / (2 mu sum 1/h^2) or the advective limit
+/// dt max(|v_x|/dx + |v_y|/dy + |v_z|/dz) <= 1, and when the pressure solve did not converge
+/// within the iteration limit.
+///
+/// A step waits for the device once: its checks and the pressure solve's decisions are
+/// taken on the device (detail::fluid_report, detail::poisson_control), the kernels that
+/// advance the fields run only if they passed, and the host reads the report back at the end
+/// (twice or more only when the solve needs more passes than the last one and a quarter).
+/// Its reductions and read-back go through the solver's own execution context; its kernels run
+/// on the default stream, which the context's (blocking) stream stays ordered with.
 template <class Real, class Policy, class Poisson = cg_poisson<Real, Policy>>
 class navier_stokes {
 public:
     navier_stokes(const fluid_grid<Real>& g, const fluid_params<Real>& params)
         : grid_(g), params_(params), p_(g.field_size(), Real(0)), eps_(g.field_size(), Real(0)),
           rhs_(g.field_size(), Real(0)), phi_(g.field_size(), Real(1)), dphi_(g.field_size(), Real(0)),
-          force_(g.field_size(), vec3<Real>{0, 0, 0}), poisson_(g)
+          force_(g.field_size(), vec3<Real>{0, 0, 0}), poisson_(g), report_(1, initial_report())
     {
         params_.validate();
         const bool pressure_end = params_.bottom.kind == fluid_boundary_kind::pressure ||
@@ -392,8 +454,8 @@ public:
         return v;
     }
 
-    /// Takes the porosity and its rate from an estimator (same grid). Throws when a cell's
-    /// porosity is not in (0, 1].
+    /// Takes the porosity and its rate from an estimator (same grid). The next step throws
+    /// when a cell's porosity is not in (0, 1] (nothing is read back here).
     void set_porosity(const porosity_view<Real>& in)
     {
         for (int a = 0; a < 3; ++a)
@@ -401,10 +463,8 @@ public:
                 detail::fail("fluid: the porosity grid has ", in.grid.n[a], " cells along axis ", a, ", the fluid grid ",
                              grid_.n[a]);
         for_each_index(Policy{}, grid_.cell_count(), detail::copy_porosity<Real>{view(), in});
-        const Real lowest = transform_reduce(Policy{}, grid_.cell_count(), detail::cell_porosity<Real>{view()},
-                                             Real(1), min_op{});
-        if (!(lowest > Real(0)))
-            detail::fail("fluid: a cell has porosity ", lowest, "; the fluid needs porosity in (0, 1] everywhere");
+        transform_reduce_into(context_, grid_.cell_count(), detail::cell_porosity<Real>{view()}, Real(1), min_op{},
+                              &report_.data()->lowest_porosity);
         fill_cell_ghosts(phi_, false);
         fill_cell_ghosts(dphi_, false);
     }
@@ -479,13 +539,23 @@ public:
     }
 
     /// Advances the fluid by dt (s); see the class comment for what it checks.
-    void step(Real dt)
+    void step(Real dt) { check(advance(dt), dt); }
+
+    /// The step without its checks' errors: advances the fluid by dt if every check passes and
+    /// the solve converges, and returns the host's copy of the step's report (hold: why it did
+    /// not advance). Throws only when dt is not positive and finite, on bad solver settings, and
+    /// when the solve's criterion became NaN or infinite. `check` throws the rest.
+    const detail::fluid_report<Real>& advance(Real dt)
     {
         if (!(dt > 0) || !std::isfinite(dt)) detail::fail("fluid: time step dt = ", dt, " s must be positive and finite");
-        const Real limit = stable_time_step();
-        if (!(dt <= limit))
-            detail::fail("fluid: time step dt = ", dt, " s exceeds the stability limit ", limit,
-                         " s (diffusive phi rho h^2/(6 mu) or advective h/|v|); reduce dt or coarsen the grid");
+        detail::fluid_report<Real>* r = report_.data();
+        Real inv_h2 = 0;
+        for (int a = 0; a < 3; ++a) inv_h2 += Real(1) / (grid_.width[a] * grid_.width[a]);
+        transform_reduce_into(context_, grid_.cell_count(), detail::cell_porosity<Real>{view()}, Real(1), min_op{},
+                              &r->phi_min);
+        transform_reduce_into(context_, grid_.cell_count(), detail::advective_rate<Real>{view()}, Real(0), max_op{},
+                              &r->rate);
+        for_each_index(Policy{}, 1, detail::fluid_precheck<Real>{r, dt, params_.density, params_.viscosity, inv_h2});
         for_each_index(Policy{}, grid_.field_size(),
                        detail::fill_cell_ghosts<Real, vec3<Real>>{grid_, force_.data(), false});
         const fluid_view<Real> f = view();
@@ -499,19 +569,75 @@ public:
         poisson_boundaries bc;
         bc.bottom = params_.bottom.kind == fluid_boundary_kind::pressure ? z_boundary::dirichlet : z_boundary::neumann;
         bc.top = params_.top.kind == fluid_boundary_kind::pressure ? z_boundary::dirichlet : z_boundary::neumann;
-        last_solve_ = poisson_.solve(eps_.data(), rhs_.data(), bc, params_.poisson);
-        if (!last_solve_.converged)
+        poisson_.launch(context_, &r->solve, &r->hold, eps_.data(), rhs_.data(), bc, params_.poisson);
+        correct(dt, vs);
+        context_.read_back(&host_report_, r, 1, "the fluid step's report", steps_);
+        while (!host_report_.solve.finished) {
+            poisson_.resume(context_);
+            correct(dt, vs);
+            context_.read_back(&host_report_, r, 1, "the fluid step's report", steps_);
+        }
+        if (host_report_.hold == detail::fluid_advances) {
+            last_solve_ = poisson_.learn(host_report_.solve);
+            if (host_report_.commit) {
+                time_ += double(dt);
+                ++steps_;
+            }
+        }
+        return host_report_;
+    }
+
+    /// Throws the error of a step that did not advance (report: advance's), naming the check.
+    void check(const detail::fluid_report<Real>& report, Real dt) const
+    {
+        switch (report.hold) {
+        case detail::fluid_hold_porosity:
+            detail::fail("fluid: a cell has porosity ", report.lowest_porosity,
+                         "; the fluid needs porosity in (0, 1] everywhere");
+        case detail::fluid_hold_response:
+            detail::fail("fluid: time step dt = ", dt, " s exceeds the shortest particle response time ",
+                         report.response, " s");
+        case detail::fluid_hold_stability:
+            detail::fail("fluid: time step dt = ", dt, " s exceeds the stability limit ", report.limit,
+                         " s (diffusive phi rho h^2/(6 mu) or advective h/|v|); reduce dt or coarsen the grid");
+        default:
+            break;
+        }
+        if (!report.commit)
             detail::fail("fluid: the pressure solve did not converge at t = ", time_, " s: residual ",
                          last_solve_.residual, " after ", last_solve_.iterations, " iterations (tolerance ",
                          params_.poisson.tolerance, "); raise fluid_params::poisson.max_iterations or reduce dt");
-        for_each_index(Policy{}, grid_.cell_count(),
-                       detail::correct_velocity<Real>{f, {vs[0], vs[1], vs[2]}, eps_.data(), dt, params_.beta});
-        fill_velocity_ghosts();
-        fill_pressure_ghosts();
-        time_ += double(dt);
     }
 
+    /// The fluid's execution context (its reductions, scratch and read-backs).
+    execution_context<Policy>& context() { return context_; }
+    /// The step's report in the policy's memory, for a caller that adds its own checks and
+    /// sums to it (the coupling: the response time, the work).
+    detail::fluid_report<Real>* report() { return report_.data(); }
+
 private:
+    static detail::fluid_report<Real> initial_report()
+    {
+        detail::fluid_report<Real> r{};
+        r.lowest_porosity = 1;
+        r.response = Real(1e30);
+        return r;
+    }
+
+    /// Where the step's solve finished and nothing held: the projection of the predicted
+    /// velocities vs (detail::correct_velocity) and the ghosts.
+    void correct(Real dt, const Real* const* vs)
+    {
+        const int* go = &report_.data()->commit;
+        for_each_index(Policy{}, 1, detail::fluid_commit<Real>{report_.data()});
+        for_each_index_if(Policy{}, go, grid_.cell_count(),
+                          detail::correct_velocity<Real>{view(), {vs[0], vs[1], vs[2]}, eps_.data(), dt, params_.beta});
+        const fluid_view<Real> f = view();
+        for_each_index_if(Policy{}, go, grid_.field_size(),
+                          detail::fill_velocity_ghosts<Real>{grid_, {f.u[0], f.u[1], f.u[2]}, f.wall_bottom, f.wall_top});
+        for_each_index_if(Policy{}, go, grid_.field_size(), detail::fill_cell_ghosts<Real, Real>{grid_, p_.data(), true});
+    }
+
     void fill_cell_ghosts(buffer<Real, Policy>& b, bool extrapolate_z)
     {
         for_each_index(Policy{}, grid_.field_size(),
@@ -566,8 +692,12 @@ private:
     buffer<Real, Policy> p_, eps_, rhs_, phi_, dphi_;
     buffer<vec3<Real>, Policy> force_;
     Poisson poisson_;
+    execution_context<Policy> context_;
+    buffer<detail::fluid_report<Real>, Policy> report_;
+    detail::fluid_report<Real> host_report_{};
     poisson_result last_solve_{};
     double time_ = 0;
+    std::size_t steps_ = 0; ///< steps taken (names a failed read-back)
 };
 
 } // namespace sphere

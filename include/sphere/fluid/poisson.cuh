@@ -71,16 +71,16 @@
 /// **Determinism.** Every kernel writes only its own cells, and every reduction has a fixed
 /// association order: on the host, fixed groups of whole rows are summed in order (in
 /// parallel over groups) and the group sums in order, independent of the thread count; on
-/// the GPU through transform_reduce (CUB, run-to-run deterministic). The same input on the
+/// the GPU through transform_reduce_into (CUB, run-to-run deterministic). The same input on the
 /// same backend gives bit-identical output (on the host, for any number of threads).
 #include <cmath>
 #include <cstddef>
-#include <vector>
 
 #include "../core/config.cuh"
 #include "../core/error.cuh"
 #include "../exec/algorithms.cuh"
 #include "../exec/buffer.cuh"
+#include "../exec/context.cuh"
 #include "../exec/for_each.cuh"
 #include "grid.cuh"
 
@@ -249,11 +249,11 @@ struct poisson_residual_squared {
     poisson_stencil<Real> s;
     const Real* e;
     const Real* b;
-    poisson_shift shift; ///< mean of b in the singular case, else 0
+    const poisson_shift* shift; ///< mean of b in the singular case, else 0 (policy memory)
 
     SPHERE_HD double operator()(std::size_t f) const
     {
-        const double r = shift.from(double(b[f])) - s.laplacian(e, f);
+        const double r = shift->from(double(b[f])) - s.laplacian(e, f);
         return r * r;
     }
 };
@@ -268,11 +268,11 @@ struct poisson_rhs_squared {
     poisson_stencil<Real> s;
     const Real* e; ///< holds the Dirichlet values
     const Real* b;
-    poisson_shift shift;
+    const poisson_shift* shift;
 
     SPHERE_HD double operator()(std::size_t f) const
     {
-        double v = shift.from(double(b[f]));
+        double v = shift->from(double(b[f]));
         const int k = static_cast<int>(f / s.sz) - 1;
         if (s.bottom_dirichlet && k == s.k_first) v -= s.cz * double(e[f - s.sz]);
         if (s.top_dirichlet && k == s.k_first + s.k_count - 1) v -= s.cz * double(e[f + s.sz]);
@@ -287,20 +287,20 @@ struct field_cell_value {
     SPHERE_HD double operator()(std::size_t f) const { return double(v[f]); }
 };
 
-/// The value of a cell of a field minus `offset`, in double. Summed over the cells: their sum.
+/// The value of a cell of a field minus `*offset`, in double. Summed over the cells: their sum.
 template <class Real>
 struct field_cell_offset {
     const Real* v;
-    double offset;
-    SPHERE_HD double operator()(std::size_t f) const { return double(v[f]) - offset; }
+    const double* offset;
+    SPHERE_HD double operator()(std::size_t f) const { return double(v[f]) - *offset; }
 };
 
-/// v -= value on a cell.
+/// v -= Real(*value) on a cell (value in the policy's memory).
 template <class Real>
 struct subtract_from_cells {
     Real* v;
-    Real value;
-    SPHERE_HD void operator()(std::size_t f) const { v[f] -= value; }
+    const double* value;
+    SPHERE_HD void operator()(std::size_t f) const { v[f] -= Real(*value); }
 };
 
 /// dst[i] = src[i].
@@ -338,18 +338,18 @@ struct normalized_change_max {
 };
 
 /// The parts of the normalized change at cell f between the new iterate x and the
-/// previous one: the change is x - old when `old` is given, else step * p (a CG step).
+/// previous one: the change is x - old when `old` is given, else *step * p (a CG step).
 template <class Real>
 struct normalized_change_at {
     const Real* x;
     const Real* old;
     const Real* p;
-    double step;
+    const double* step;
 
     SPHERE_HD normalized_change_parts operator()(std::size_t f) const
     {
         const double n = double(x[f]);
-        const double d = old ? n - double(old[f]) : step * double(p[f]);
+        const double d = old ? n - double(old[f]) : *step * double(p[f]);
         const double n2 = n * n, d2 = d * d;
         if (n2 > 0) return {d2 / n2, n2, 0.0};
         return {0.0, 0.0, d2};
@@ -358,9 +358,10 @@ struct normalized_change_at {
 
 /// The normalized change from its reduced parts: a cell with eps_new = 0 that changed is
 /// measured against the largest eps_new^2 (1 when the whole field is 0). NaN propagates.
-inline double normalized_change_value(const normalized_change_parts& m)
+SPHERE_HD inline double normalized_change_value(const normalized_change_parts& m)
 {
-    if (std::isnan(m.ratio) || std::isnan(m.new2) || std::isnan(m.zero_change2)) return std::nan("");
+    if (m.ratio != m.ratio || m.new2 != m.new2 || m.zero_change2 != m.zero_change2)
+        return m.ratio + m.new2 + m.zero_change2; // NaN
     if (m.zero_change2 == 0) return m.ratio;
     const double zero = m.new2 > 0 ? m.zero_change2 / m.new2 : 1.0;
     return m.ratio < zero ? zero : m.ratio;
@@ -376,7 +377,7 @@ template <class Real>
 struct jacobi_sweep {
     poisson_stencil<Real> s;
     Real wx, wy, wz, wb;
-    Real shift;
+    const poisson_shift* shift; ///< policy memory
     const Real* b;
     const Real* old;
     Real* out;
@@ -384,7 +385,7 @@ struct jacobi_sweep {
     SPHERE_HD void operator()(std::size_t f) const
     {
         out[f] = wx * (old[f - 1] + old[f + 1]) + wy * (old[f - s.sy] + old[f + s.sy]) +
-                 wz * (old[f - s.sz] + old[f + s.sz]) - wb * (b[f] - shift);
+                 wz * (old[f - s.sz] + old[f + s.sz]) - wb * (b[f] - Real(shift->hi + shift->lo));
     }
 };
 
@@ -457,6 +458,174 @@ struct transform_cell {
     SPHERE_HD auto operator()(std::size_t u) const { return f(s.field(u)); }
 };
 
+/// A solve's state in the policy's memory (docs/fluid.md, *Solves without waiting*): the
+/// solver's scalars and its decisions live on the device next to the fields, so that a solve
+/// is launched without reading anything back, and its caller reads this struct once, inside its
+/// own report. The solver's loop is launched as a number of passes; a pass whose flag is 0
+/// launches kernels that do nothing (for_each_index_if). Flags are ints, pointed at by guards.
+struct poisson_control {
+    double tolerance;
+    unsigned max_iterations;
+    int relative; ///< criterion == relative_residual
+    poisson_shift shift;
+    double b_norm;    ///< ||b_u|| (relative_residual)
+    double threshold; ///< CG: tolerance x b_norm (x 1 when b_norm = 0), where it checks the true residual
+    // Reductions of the current pass, valid where the flag that launched them is set.
+    double sum, sum2;
+    normalized_change_parts change;
+    // Conjugate gradients: r.r, the step, the direction's beta, the mean projected out of r,
+    // the best true residual so far and the checks since it halved.
+    double rr, alpha, beta, mean, best;
+    unsigned stalls;
+    int active;      ///< the loop goes on
+    int iterate;     ///< this pass applies A (CG) or sweeps (Jacobi)
+    int stepping;    ///< CG: this pass takes a step
+    int checking;    ///< CG: this pass evaluates the true residual
+    int restarting;  ///< CG: this pass restarts from the true residual
+    int directing;   ///< CG: this pass updates the direction
+    int finished;    ///< the loop is over (set by poisson_conclude)
+    int finishing;   ///< the end of the solve applies (finished, not held, no error)
+    int final_check; ///< CG: the end evaluates the true residual
+    int odd;         ///< Jacobi: the iterate is in the scratch field
+    int held;        ///< the caller's own checks failed before the solve: nothing ran
+    int error;       ///< 1: the criterion became NaN, 2: infinite
+    unsigned error_iterations;
+    unsigned iterations;
+    unsigned passes; ///< passes that did work (the next solve's budget)
+    double residual;
+    int converged;
+    int found; ///< CG: converged inside the loop
+};
+
+/// The result of a finished solve, from the host's copy of its control; throws the error of a
+/// criterion that became NaN or infinite.
+inline poisson_result result_of(const poisson_control& c)
+{
+    if (c.error == 1)
+        fail("Poisson solver: residual became NaN after ", c.error_iterations,
+             " iterations (a NaN or infinite value in the right-hand side, the Dirichlet values or the "
+             "initial guess, or divergence)");
+    if (c.error == 2)
+        fail("Poisson solver: residual became infinite after ", c.error_iterations,
+             " iterations (an infinite value in the input, or divergence)");
+    poisson_result r;
+    r.iterations = c.iterations;
+    r.residual = c.residual;
+    r.converged = c.converged != 0;
+    return r;
+}
+
+/// Records a criterion value that is NaN or infinite as the solve's error and stops the loop;
+/// true if it was.
+SPHERE_HD inline bool stop_if_not_finite(poisson_control& c, double value, unsigned iterations)
+{
+    const bool nan = value != value, infinite = !nan && !(value - value == 0);
+    if (!nan && !infinite) return false;
+    c.error = nan ? 1 : 2;
+    c.error_iterations = iterations;
+    c.active = 0;
+    return true;
+}
+
+/// Starts a solve: the settings, every flag cleared; held (nothing runs) if *hold.
+struct poisson_begin {
+    poisson_control* c;
+    double tolerance;
+    unsigned max_iterations;
+    int relative;
+    const int* hold; ///< may be null
+
+    SPHERE_HD void operator()(std::size_t) const
+    {
+        c->tolerance = tolerance;
+        c->max_iterations = max_iterations;
+        c->relative = relative;
+        c->shift.hi = c->shift.lo = 0;
+        c->b_norm = c->threshold = c->sum = c->sum2 = 0;
+        c->change = normalized_change_parts{0.0, 0.0, 0.0};
+        c->rr = c->alpha = c->beta = c->mean = c->best = 0;
+        c->stalls = 0;
+        c->held = hold && *hold ? 1 : 0;
+        c->active = !c->held;
+        c->iterate = c->stepping = c->checking = c->restarting = c->directing = 0;
+        c->finished = c->finishing = c->final_check = c->odd = c->error = 0;
+        c->error_iterations = c->iterations = c->passes = 0;
+        c->residual = 0;
+        c->converged = c->found = 0;
+    }
+};
+
+/// *to = c->sum / count (a mean of the cells), or c->shift.hi or .lo.
+struct poisson_mean_of_sum {
+    poisson_control* c;
+    double* to;
+    double count;
+    SPHERE_HD void operator()(std::size_t) const { *to = c->sum / count; }
+};
+
+/// The criterion on the initial guess (the file comment): converged, or the loop starts
+/// (CG: from a restart). sum holds ||b - A eps||^2, sum2 ||b_u||^2 (relative_residual).
+struct poisson_initial_check {
+    poisson_control* c;
+    int restart; ///< CG: the loop begins with a restart
+
+    SPHERE_HD void operator()(std::size_t) const
+    {
+        if (c->held) return;
+        c->b_norm = c->relative ? sqrt(c->sum2) : 0.0;
+        c->threshold = c->tolerance * (c->b_norm > 0 ? c->b_norm : 1.0);
+        const double res = sqrt(c->sum);
+        if (stop_if_not_finite(*c, res, 0)) return;
+        if (c->relative) {
+            c->residual = c->b_norm > 0 ? res / c->b_norm : res;
+            if (stop_if_not_finite(*c, c->residual, 0)) return;
+        }
+        if (c->relative ? c->residual <= c->tolerance : res == 0) {
+            c->converged = c->found = 1;
+            c->active = 0;
+            return;
+        }
+        c->best = c->residual;
+        c->restarting = restart;
+    }
+};
+
+/// After the last pass of a launch: the loop is over when it stopped or, where the loop does
+/// not look at the criterion after its last iteration (`stop_at_max`), reached
+/// max_iterations; then the end of the solve applies unless it was held or failed.
+struct poisson_conclude {
+    poisson_control* c;
+    int stop_at_max;
+    int check_unfound; ///< CG: a loop that did not find convergence checks the true residual
+
+    SPHERE_HD void operator()(std::size_t) const
+    {
+        if (stop_at_max && c->active && c->iterations >= c->max_iterations) c->active = 0;
+        if (c->active || c->finished) return;
+        c->finished = 1;
+        if (c->held || c->error) return;
+        c->finishing = 1;
+        c->final_check = check_unfound && !c->found && c->relative;
+        c->odd = c->iterations % 2;
+    }
+};
+
+/// The final true residual of a CG loop that did not find convergence (sum: its square).
+struct poisson_final_check {
+    poisson_control* c;
+    SPHERE_HD void operator()(std::size_t) const
+    {
+        if (!c->final_check) return;
+        const double res = sqrt(c->sum);
+        c->residual = c->b_norm > 0 ? res / c->b_norm : res;
+        if (stop_if_not_finite(*c, c->residual, c->iterations)) {
+            c->finishing = 0;
+            return;
+        }
+        c->converged = c->residual <= c->tolerance;
+    }
+};
+
 template <class Real, class Kernel>
 void for_each_cell(host, const poisson_stencil<Real>& s, const Kernel& k)
 {
@@ -464,19 +633,28 @@ void for_each_cell(host, const poisson_stencil<Real>& s, const Kernel& k)
     for_each_index(host{}, (s.rows() + rows - 1) / rows, over_rows<Real, Kernel>{s, k, rows});
 }
 
-/// init op (f over the cells of the layers of s), deterministic: on the host each index's
-/// rows are reduced in order along x (indices in parallel) and the indices' results in
-/// order; on the GPU through transform_reduce (CUB, run-to-run deterministic). `partial`
-/// is host scratch.
-template <class Real, class T, class Transform, class Op>
-T reduce_cells(host, const poisson_stencil<Real>& s, const Transform& f, T init, Op op, std::vector<T>& partial)
+/// for_each_cell if *go (policy memory) is not 0 when its turn comes.
+template <class Real, class Kernel>
+void for_each_cell_if(host, const poisson_stencil<Real>& s, const int* go, const Kernel& k)
 {
+    if (*go) for_each_cell(host{}, s, k);
+}
+
+/// *out = init op (f over the cells of the layers of s), if *go; deterministic: on the host each
+/// index's rows are reduced in order along x (indices in parallel) and the indices' results in
+/// order; on the GPU through transform_reduce_into (CUB, run-to-run deterministic), where a
+/// pass with *go = 0 writes init op ... op init, which no decision reads.
+template <class Real, class T, class Transform, class Op>
+void reduce_cells_into(execution_context<host>& ctx, const poisson_stencil<Real>& s, const int* go,
+                       const Transform& f, T init, Op op, T* out)
+{
+    if (go && !*go) return;
     const std::size_t rows = host_rows_per_index(s.grid.n[0]), n = (s.rows() + rows - 1) / rows;
-    partial.resize(n);
-    for_each_index(host{}, n, reduce_rows<Real, Transform, T, Op>{s, f, op, rows, partial.data()});
+    T* partial = static_cast<T*>(ctx.scratch(n * sizeof(T)));
+    for_each_index(host{}, n, reduce_rows<Real, Transform, T, Op>{s, f, op, rows, partial});
     T acc = init;
-    for (const T& r : partial) acc = op(acc, r);
-    return acc;
+    for (std::size_t i = 0; i < n; ++i) acc = op(acc, partial[i]);
+    *out = acc;
 }
 
 #if SPHERE_CUDA_COMPILER
@@ -486,15 +664,33 @@ void for_each_cell(cuda, const poisson_stencil<Real>& s, const Kernel& k)
     for_each_index(cuda{}, s.unknowns(), over_cells<Real, Kernel>{s, k});
 }
 
-template <class Real, class T, class Transform, class Op>
-T reduce_cells(cuda, const poisson_stencil<Real>& s, const Transform& f, T init, Op op, std::vector<T>&)
+template <class Real, class Kernel>
+void for_each_cell_if(cuda, const poisson_stencil<Real>& s, const int* go, const Kernel& k)
 {
-    return transform_reduce(cuda{}, s.unknowns(), transform_cell<Real, Transform>{s, f}, init, op);
+    for_each_index_if(cuda{}, go, s.unknowns(), over_cells<Real, Kernel>{s, k});
+}
+
+/// f(s.field(u)) where *go, else init.
+template <class Real, class Transform, class T>
+struct transform_cell_if {
+    poisson_stencil<Real> s;
+    Transform f;
+    const int* go;
+    T init;
+    SPHERE_HD T operator()(std::size_t u) const { return (!go || *go) ? T(f(s.field(u))) : init; }
+};
+
+template <class Real, class T, class Transform, class Op>
+void reduce_cells_into(execution_context<cuda>& ctx, const poisson_stencil<Real>& s, const int* go,
+                       const Transform& f, T init, Op op, T* out)
+{
+    transform_reduce_into(ctx, s.unknowns(), transform_cell_if<Real, Transform, T>{s, f, go, init}, init, op, out);
 }
 #endif
 
-/// The problem set-up shared by the solvers: the stencil, the boundaries, the host-side
-/// checks and the whole-field operations (ghosts, norms, means).
+/// The problem set-up shared by the solvers: the stencil, the boundaries, the host-side checks
+/// of the settings, and the whole-field operations (ghosts, norms, means), each launched
+/// without waiting, its scalars in a poisson_control.
 template <class Real, class Policy>
 class poisson_problem {
 public:
@@ -527,119 +723,212 @@ public:
         all_.k_first = 0;
         all_.k_count = static_cast<int>(grid_.n[2]);
         singular_ = !bottom && !top;
-        shift_ = poisson_shift{};
+        relative_ = st.criterion == poisson_criterion::relative_residual;
     }
 
     const poisson_stencil<Real>& stencil() const { return s_; }
-    /// The mean of b removed in the singular case (hi + lo), else 0.
-    const poisson_shift& shift() const { return shift_; }
     /// Neumann at both ends: A annihilates the constants, and every cell is an unknown.
     bool singular() const { return singular_; }
+    bool relative() const { return relative_; }
 
-    /// Runs the cell kernel k(f) on every unknown cell.
+    /// The start of a solve of A eps = rhs with the settings of prepare: the control's begin,
+    /// eps's ghosts, the singular case's means (shift = mean of b as hi + lo, see
+    /// poisson_shift; eps made zero-mean), and the criterion on the initial guess
+    /// (poisson_initial_check). Nothing is read back.
+    void start(execution_context<Policy>& ctx, poisson_control* c, const int* hold, const poisson_settings& st,
+               Real* eps, const Real* rhs, bool restart)
+    {
+        for_each_index(Policy{}, 1, poisson_begin{c, st.tolerance, st.max_iterations, relative_ ? 1 : 0, hold});
+        fill_ghosts(eps, nullptr);
+        if (singular_) {
+            const double cells = double(grid_.cell_count());
+            reduce_cells_into(ctx, all_, nullptr, field_cell_value<Real>{rhs}, 0.0, plus_op{}, &c->sum);
+            for_each_index(Policy{}, 1, poisson_mean_of_sum{c, &c->shift.hi, cells});
+            reduce_cells_into(ctx, all_, nullptr, field_cell_offset<Real>{rhs, &c->shift.hi}, 0.0, plus_op{}, &c->sum);
+            for_each_index(Policy{}, 1, poisson_mean_of_sum{c, &c->shift.lo, cells});
+            // subtract_mean changes the cells only: the ghosts are refilled, or stale ones would
+            // keep the old offset in the stencil of the boundary cells.
+            subtract_mean(ctx, c, nullptr, eps);
+            fill_ghosts(eps, nullptr);
+        }
+        if (relative_)
+            reduce_cells_into(ctx, s_, nullptr, poisson_rhs_squared<Real>{s_, eps, rhs, &c->shift}, 0.0, plus_op{},
+                              &c->sum2);
+        reduce_cells_into(ctx, s_, nullptr, poisson_residual_squared<Real>{s_, eps, rhs, &c->shift}, 0.0, plus_op{},
+                          &c->sum);
+        for_each_index(Policy{}, 1, poisson_initial_check{c, restart ? 1 : 0});
+    }
+
+    /// The end of the passes launched so far: poisson_conclude, then, where the solve is over,
+    /// the final residual (CG), the copy of the scratch iterate into eps (Jacobi), the singular
+    /// case's zero mean, and eps's ghosts.
+    void conclude(execution_context<Policy>& ctx, poisson_control* c, Real* eps, const Real* rhs,
+                  const Real* scratch_iterate, bool stop_at_max, bool check_unfound)
+    {
+        for_each_index(Policy{}, 1, poisson_conclude{c, stop_at_max ? 1 : 0, check_unfound ? 1 : 0});
+        if (check_unfound && relative_) {
+            fill_ghosts(eps, &c->final_check);
+            residual_squared_into(ctx, &c->final_check, eps, rhs, c, &c->sum);
+            for_each_index(Policy{}, 1, poisson_final_check{c});
+        }
+        if (scratch_iterate)
+            for_each_index_if(Policy{}, &c->odd, grid_.field_size(), copy_values<Real>{scratch_iterate, eps});
+        if (singular_) subtract_mean(ctx, c, &c->finishing, eps);
+        fill_ghosts(eps, &c->finishing);
+    }
+
+    /// Runs the cell kernel k(f) on every unknown cell if *go (always if go is null).
     template <class Kernel>
-    void for_each_unknown(const Kernel& k) const
+    void for_each_unknown(const int* go, const Kernel& k) const
     {
-        for_each_cell(Policy{}, s_, k);
+        if (go)
+            for_each_cell_if(Policy{}, s_, go, k);
+        else
+            for_each_cell(Policy{}, s_, k);
     }
 
-    /// The sum (in double) of the cell transform f(f) over the unknown cells.
+    /// *out = the sum (in double) of the cell transform f(f) over the unknown cells, if *go.
     template <class Transform>
-    double sum_unknowns(const Transform& f)
+    void sum_unknowns_into(execution_context<Policy>& ctx, const int* go, const Transform& f, double* out) const
     {
-        return reduce_cells(Policy{}, s_, f, 0.0, plus_op{}, row_sums_);
+        reduce_cells_into(ctx, s_, go, f, 0.0, plus_op{}, out);
     }
 
-    /// In the singular case: shift = mean of b over the cells (as hi + lo, see poisson_shift),
-    /// and eps made zero-mean, its ghosts refilled (subtract_mean changes the cells only; stale
-    /// ghosts would keep the old offset in the stencil of the boundary cells).
-    void remove_means(Real* eps, const Real* b)
+    /// *out = ||b - shift - A e||^2 over the unknowns (double), if *go; e with filled ghosts.
+    void residual_squared_into(execution_context<Policy>& ctx, const int* go, const Real* e, const Real* b,
+                               const poisson_control* c, double* out) const
     {
-        if (!singular_) return;
-        shift_.hi = cell_mean(b);
-        shift_.lo = reduce_cells(Policy{}, all_, field_cell_offset<Real>{b, shift_.hi}, 0.0, plus_op{}, row_sums_) /
-                    double(grid_.cell_count());
-        subtract_mean(eps);
-        fill_ghosts(eps);
+        sum_unknowns_into(ctx, go, poisson_residual_squared<Real>{s_, e, b, &c->shift}, out);
     }
 
-    void subtract_mean(Real* eps)
+    /// *out = the parts of the normalized change between x and old (old != nullptr) or of the
+    /// step *step p, if *go.
+    void normalized_change_into(execution_context<Policy>& ctx, const int* go, const Real* x, const Real* old,
+                                const Real* p, const double* step, normalized_change_parts* out) const
     {
-        const double m = cell_mean(eps);
-        if (m != 0) for_each_cell(Policy{}, all_, subtract_from_cells<Real>{eps, Real(m)});
+        reduce_cells_into(ctx, s_, go, normalized_change_at<Real>{x, old, p, step},
+                          normalized_change_parts{0.0, 0.0, 0.0}, normalized_change_max{}, out);
     }
 
-    void fill_ghosts(Real* e) const
+    /// eps -= its mean over the cells, if *go (c->sum and c->mean are its scratch).
+    void subtract_mean(execution_context<Policy>& ctx, poisson_control* c, const int* go, Real* eps) const
+    {
+        reduce_cells_into(ctx, all_, go, field_cell_value<Real>{eps}, 0.0, plus_op{}, &c->sum);
+        const poisson_mean_of_sum mean{c, &c->mean, double(grid_.cell_count())};
+        const subtract_from_cells<Real> subtract{eps, &c->mean};
+        if (go) {
+            for_each_index_if(Policy{}, go, 1, mean);
+            for_each_cell_if(Policy{}, all_, go, subtract);
+        } else {
+            for_each_index(Policy{}, 1, mean);
+            for_each_cell(Policy{}, all_, subtract);
+        }
+    }
+
+    /// Fills e's ghosts (file comment) if *go (always if go is null).
+    void fill_ghosts(Real* e, const int* go) const
     {
         const std::size_t count = grid_.field_size() - grid_.cell_count();
         const std::size_t per_index = runs_in_blocks<Policy> ? host_cells_per_index : 1;
-        for_each_index(Policy{}, (count + per_index - 1) / per_index,
-                       fill_poisson_ghosts<Real>{s_, e, per_index, count});
+        const fill_poisson_ghosts<Real> k{s_, e, per_index, count};
+        const std::size_t n = (count + per_index - 1) / per_index;
+        if (go)
+            for_each_index_if(Policy{}, go, n, k);
+        else
+            for_each_index(Policy{}, n, k);
     }
 
-    /// ||b - shift - A e||_2 over the unknowns (double); e with filled ghosts.
-    double residual_norm(const Real* e, const Real* b)
+    /// dst = src on the whole field (cells and ghosts), if *go.
+    void copy(const Real* src, Real* dst, const int* go) const
     {
-        return std::sqrt(sum_unknowns(poisson_residual_squared<Real>{s_, e, b, shift_}));
-    }
-
-    /// ||b - shift - known Dirichlet terms||_2 over the unknowns (double); e holds the
-    /// Dirichlet values.
-    double rhs_norm(const Real* e, const Real* b)
-    {
-        return std::sqrt(sum_unknowns(poisson_rhs_squared<Real>{s_, e, b, shift_}));
-    }
-
-    /// The normalized change between x and old (old != nullptr) or of the step step * p.
-    double normalized_change(const Real* x, const Real* old, const Real* p, double step)
-    {
-        return normalized_change_value(reduce_cells(Policy{}, s_, normalized_change_at<Real>{x, old, p, step},
-                                                    normalized_change_parts{0.0, 0.0, 0.0}, normalized_change_max{},
-                                                    row_changes_));
-    }
-
-    /// dst = src on the whole field (cells and ghosts).
-    void copy(const Real* src, Real* dst) const
-    {
-        for_each_index(Policy{}, grid_.field_size(), copy_values<Real>{src, dst});
+        for_each_index_if(Policy{}, go, grid_.field_size(), copy_values<Real>{src, dst});
     }
 
     /// v = 0 on the whole field.
     void zero(Real* v) const { for_each_index(Policy{}, grid_.field_size(), set_values<Real>{v, Real(0)}); }
 
-    /// Throws when a criterion value is NaN or infinite.
-    static void check_finite(double value, unsigned iterations)
-    {
-        if (std::isnan(value))
-            fail("Poisson solver: residual became NaN after ", iterations,
-                 " iterations (a NaN or infinite value in the right-hand side, the Dirichlet values or the "
-                 "initial guess, or divergence)");
-        if (!std::isfinite(value))
-            fail("Poisson solver: residual became infinite after ", iterations,
-                 " iterations (an infinite value in the input, or divergence)");
-    }
-
-    /// The end of a solve: the singular case's zero mean, and the ghosts.
-    void finish(Real* eps)
-    {
-        if (singular_) subtract_mean(eps);
-        fill_ghosts(eps);
-    }
-
 private:
-    double cell_mean(const Real* v)
-    {
-        return reduce_cells(Policy{}, all_, field_cell_value<Real>{v}, 0.0, plus_op{}, row_sums_) /
-               double(grid_.cell_count());
-    }
-
     fluid_grid<Real> grid_;
     poisson_stencil<Real> s_{};   ///< the unknown layers
     poisson_stencil<Real> all_{}; ///< every cell layer
     bool singular_ = false;
-    poisson_shift shift_{};
-    std::vector<double> row_sums_; ///< host scratch of the reductions
-    std::vector<normalized_change_parts> row_changes_;
+    bool relative_ = true;
+};
+
+/// How many passes a solve launches before it first reads its control back: the passes the
+/// last solve used, a quarter more and 4, at least `first`; a solve that has not finished
+/// doubles it for the next launch.
+struct poisson_budget {
+    unsigned passes = 16;
+    void learn(unsigned used) { passes = used + used / 4 + 4 < 16 ? 16 : used + used / 4 + 4; }
+};
+
+/// The solve() of both solvers: launch, read the control back, resume until it finished.
+template <class Solver, class Real, class Policy>
+poisson_result solve_and_wait(Solver& solver, execution_context<Policy>& ctx, buffer<poisson_control, Policy>& control,
+                              Real* eps, const Real* rhs, const poisson_boundaries& bc, const poisson_settings& st)
+{
+    solver.launch(ctx, control.data(), nullptr, eps, rhs, bc, st);
+    poisson_control c{};
+    ctx.read_back(&c, control.data(), 1, "the Poisson solve's control", 0);
+    while (!c.finished) {
+        solver.resume(ctx);
+        ctx.read_back(&c, control.data(), 1, "the Poisson solve's control", 0);
+    }
+    return solver.learn(c);
+}
+
+/// Jacobi decisions of one pass (relative_residual): the criterion of the current iterate
+/// (sum: its squared residual), then a sweep unless converged or at max_iterations.
+struct jacobi_residual_check {
+    poisson_control* c;
+    SPHERE_HD void operator()(std::size_t) const
+    {
+        c->iterate = 0;
+        if (!c->active) return;
+        ++c->passes;
+        const double r = sqrt(c->sum);
+        c->residual = c->b_norm > 0 ? r / c->b_norm : r;
+        if (stop_if_not_finite(*c, c->residual, c->iterations)) return;
+        if (c->residual <= c->tolerance) {
+            c->converged = 1;
+            c->active = 0;
+            return;
+        }
+        if (c->iterations == c->max_iterations) {
+            c->active = 0;
+            return;
+        }
+        c->iterate = 1;
+    }
+};
+
+/// Jacobi with normalized_change: whether a pass sweeps.
+struct jacobi_begin_pass {
+    poisson_control* c;
+    SPHERE_HD void operator()(std::size_t) const
+    {
+        c->iterate = c->active && c->iterations < c->max_iterations;
+        if (c->active && !c->iterate) c->active = 0;
+        if (c->iterate) ++c->passes;
+    }
+};
+
+/// After a sweep: its count and, with normalized_change, the criterion (change: its parts).
+struct jacobi_after_sweep {
+    poisson_control* c;
+    SPHERE_HD void operator()(std::size_t) const
+    {
+        if (!c->iterate) return;
+        ++c->iterations;
+        if (c->relative) return;
+        c->residual = normalized_change_value(c->change);
+        if (stop_if_not_finite(*c, c->residual, c->iterations)) return;
+        if (c->residual <= c->tolerance) {
+            c->converged = 1;
+            c->active = 0;
+        }
+    }
 };
 
 } // namespace detail
@@ -652,7 +941,12 @@ private:
 /// of every sweep is reduced. Needs O(n^2) sweeps on an n-cell axis: it is the reference
 /// method; cg_poisson (poisson_cg.cuh) needs O(n).
 ///
-/// Owns one scratch field (the previous iterate), allocated once. Usage:
+/// The loop runs on the device without waiting (detail::poisson_control): a pass is a sweep
+/// (into the scratch field, then back), decided on the device; `solve` launches as many
+/// passes as the last solve needed and a quarter more, reads the control back once, and only
+/// launches more (doubling) if the solve had not finished.
+///
+/// Owns one scratch field (the other iterate), allocated once. Usage:
 ///
 ///     sphere::jacobi_poisson<double, sphere::host> solver(grid);
 ///     sphere::poisson_result r = solver.solve(eps, rhs, {sphere::z_boundary::neumann,
@@ -661,7 +955,7 @@ private:
 template <class Real, class Policy>
 class jacobi_poisson {
 public:
-    explicit jacobi_poisson(const fluid_grid<Real>& g) : problem_(g), scratch_(g.field_size(), Real(0)) {}
+    explicit jacobi_poisson(const fluid_grid<Real>& g) : problem_(g), scratch_(g.field_size(), Real(0)), control_(1) {}
 
     const fluid_grid<Real>& grid() const { return problem_.grid(); }
 
@@ -671,74 +965,84 @@ public:
     /// settings, nz < 3 with a Dirichlet end, or a residual that becomes NaN or infinite.
     poisson_result solve(Real* eps, const Real* rhs, const poisson_boundaries& bc, const poisson_settings& st)
     {
-        problem_.prepare(bc, st);
-        problem_.fill_ghosts(eps);
-        problem_.remove_means(eps, rhs);
-        const detail::poisson_stencil<Real>& s = problem_.stencil();
-        const double D = 2 * (s.cx + s.cy + s.cz);
-        const detail::jacobi_sweep<Real> sweep_base{s,       Real(s.cx / D), Real(s.cy / D), Real(s.cz / D),
-                                                    Real(1 / D), Real(problem_.shift().hi + problem_.shift().lo), rhs, nullptr, nullptr};
-        const bool relative = st.criterion == poisson_criterion::relative_residual;
-        const double b_norm = relative ? problem_.rhs_norm(eps, rhs) : 0.0;
+        return detail::solve_and_wait(*this, context_, control_, eps, rhs, bc, st);
+    }
 
-        poisson_result result;
-        Real* current = eps;
-        Real* next = scratch_.data();
-        if (relative) {
-            problem_.copy(eps, next); // the Dirichlet layers of both buffers
-            for (;;) {
-                const double r = problem_.residual_norm(current, rhs);
-                result.residual = b_norm > 0 ? r / b_norm : r;
-                problem_.check_finite(result.residual, result.iterations);
-                if (result.residual <= st.tolerance) {
-                    result.converged = true;
-                    break;
-                }
-                if (result.iterations == st.max_iterations) break;
-                sweep(sweep_base, current, next);
-                Real* t = current;
-                current = next;
-                next = t;
-                ++result.iterations;
-            }
-        } else {
-            const double r = problem_.residual_norm(current, rhs);
-            problem_.check_finite(r, 0);
-            if (r == 0) {
-                result.converged = true;
-            } else {
-                problem_.copy(eps, next);
-                while (result.iterations < st.max_iterations) {
-                    sweep(sweep_base, current, next);
-                    result.residual = problem_.normalized_change(next, current, nullptr, 0.0);
-                    Real* t = current;
-                    current = next;
-                    next = t;
-                    ++result.iterations;
-                    problem_.check_finite(result.residual, result.iterations);
-                    if (result.residual <= st.tolerance) {
-                        result.converged = true;
-                        break;
-                    }
-                }
-            }
-        }
-        if (current != eps) problem_.copy(current, eps);
-        problem_.finish(eps);
-        return result;
+    /// Launches a solve (solve's contract) without reading anything back: its state in the
+    /// control `c` (policy memory); nothing runs if *hold (hold may be null). Throws on bad
+    /// settings. When c->finished is 0 after the launch, resume() launches more passes.
+    void launch(execution_context<Policy>& ctx, detail::poisson_control* c, const int* hold, Real* eps,
+                const Real* rhs, const poisson_boundaries& bc, const poisson_settings& st)
+    {
+        problem_.prepare(bc, st);
+        ctx_ = &ctx;
+        c_ = c;
+        eps_ = eps;
+        rhs_ = rhs;
+        problem_.start(ctx, c, hold, st, eps, rhs, false);
+        // The Dirichlet layers of both fields.
+        problem_.copy(eps, scratch_.data(), &c->active);
+        passes_ = budget_.passes;
+        run_passes();
+    }
+
+    /// Launches more passes of the last launch (twice as many as the last time) and its end.
+    void resume(execution_context<Policy>&)
+    {
+        passes_ *= 2;
+        run_passes();
+    }
+
+    /// The result of a finished solve from the host's copy of its control (throws its
+    /// error); the passes it used set the next solve's budget.
+    poisson_result learn(const detail::poisson_control& c)
+    {
+        budget_.learn(c.passes);
+        return detail::result_of(c);
     }
 
 private:
-    void sweep(detail::jacobi_sweep<Real> k, const Real* from, Real* to)
+    /// passes_ sweeps (rounded up to pairs, so that a launch that does not finish leaves
+    /// the iterate in eps), then the end.
+    void run_passes()
     {
-        k.old = from;
-        k.out = to;
-        problem_.for_each_unknown(k);
-        problem_.fill_ghosts(to);
+        for (unsigned i = 0; i < (passes_ + 1) / 2; ++i) {
+            half_pass(eps_, scratch_.data());
+            half_pass(scratch_.data(), eps_);
+        }
+        problem_.conclude(*ctx_, c_, eps_, rhs_, scratch_.data(), !problem_.relative(), false);
+    }
+
+    /// One sweep from `from` into `to` with its decisions.
+    void half_pass(const Real* from, Real* to)
+    {
+        detail::poisson_control* c = c_;
+        const detail::poisson_stencil<Real>& s = problem_.stencil();
+        if (problem_.relative()) {
+            problem_.residual_squared_into(*ctx_, &c->active, from, rhs_, c, &c->sum);
+            for_each_index(Policy{}, 1, detail::jacobi_residual_check{c});
+        } else {
+            for_each_index(Policy{}, 1, detail::jacobi_begin_pass{c});
+        }
+        const double D = 2 * (s.cx + s.cy + s.cz);
+        const detail::jacobi_sweep<Real> k{s, Real(s.cx / D), Real(s.cy / D), Real(s.cz / D), Real(1 / D), &c->shift,
+                                           rhs_, from, to};
+        problem_.for_each_unknown(&c->iterate, k);
+        problem_.fill_ghosts(to, &c->iterate);
+        if (!problem_.relative()) problem_.normalized_change_into(*ctx_, &c->iterate, to, from, nullptr, nullptr, &c->change);
+        for_each_index(Policy{}, 1, detail::jacobi_after_sweep{c});
     }
 
     detail::poisson_problem<Real, Policy> problem_;
     buffer<Real, Policy> scratch_;
+    buffer<detail::poisson_control, Policy> control_; ///< solve()'s control
+    execution_context<Policy> context_;                ///< solve()'s context
+    detail::poisson_budget budget_;
+    unsigned passes_ = 0;
+    execution_context<Policy>* ctx_ = nullptr;
+    detail::poisson_control* c_ = nullptr;
+    Real* eps_ = nullptr;
+    const Real* rhs_ = nullptr;
 };
 
 } // namespace sphere

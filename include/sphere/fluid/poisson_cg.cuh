@@ -11,6 +11,7 @@
 #include "../core/config.cuh"
 #include "../exec/algorithms.cuh"
 #include "../exec/buffer.cuh"
+#include "../exec/context.cuh"
 #include "../exec/for_each.cuh"
 #include "grid.cuh"
 #include "poisson.cuh"
@@ -24,12 +25,12 @@ struct poisson_residual_field {
     poisson_stencil<Real> s;
     const Real* e;
     const Real* b;
-    poisson_shift shift;
+    const poisson_shift* shift; ///< policy memory
     Real* r;
 
     SPHERE_HD void operator()(std::size_t f) const
     {
-        r[f] = Real(shift.from(double(b[f])) - s.laplacian(e, f));
+        r[f] = Real(shift->from(double(b[f])) - s.laplacian(e, f));
     }
 };
 
@@ -61,10 +62,10 @@ struct poisson_dot {
     }
 };
 
-/// x += alpha p and r -= alpha q at cell f.
+/// x += alpha p and r -= alpha q at cell f (alpha from the control).
 template <class Real>
 struct cg_step {
-    Real alpha;
+    const poisson_control* c;
     const Real* p;
     const Real* q;
     Real* x;
@@ -72,24 +73,153 @@ struct cg_step {
 
     SPHERE_HD void operator()(std::size_t f) const
     {
+        const Real alpha = Real(c->alpha);
         x[f] += alpha * p[f];
         r[f] -= alpha * q[f];
     }
 };
 
-/// r -= mean (the singular case's projection; 0 otherwise) and p = r + beta p at cell f.
+/// r -= mean (the singular case's projection; 0 otherwise) and p = r + beta p at cell f (beta
+/// and mean from the control).
 template <class Real>
 struct cg_direction {
-    Real beta;
-    Real mean;
+    const poisson_control* c;
     Real* r;
     Real* p;
 
     SPHERE_HD void operator()(std::size_t f) const
     {
-        const Real v = r[f] - mean;
+        const Real v = r[f] - Real(c->mean);
         r[f] = v;
-        p[f] = v + beta * p[f];
+        p[f] = v + Real(c->beta) * p[f];
+    }
+};
+
+/// The start of a pass: it applies A while the loop goes on below max_iterations.
+struct cg_begin_pass {
+    poisson_control* c;
+    SPHERE_HD void operator()(std::size_t) const
+    {
+        c->iterate = c->active && c->iterations < c->max_iterations;
+        if (c->active && !c->iterate) c->active = 0;
+        c->stepping = c->checking = c->directing = 0;
+        if (c->iterate) ++c->passes;
+    }
+};
+
+/// After A p (sum: p.Ap): the step alpha = r.r / p.Ap, or, where p.Ap ~ 0 (p has no component
+/// that A sees: a step would be huge and meaningless), none: the true residual is checked.
+struct cg_after_apply {
+    poisson_control* c;
+    double largest_step; ///< |alpha| lambda_max beyond 1 / epsilon: see cg_poisson
+
+    SPHERE_HD void operator()(std::size_t) const
+    {
+        if (!c->iterate) return;
+        const double pq = c->sum;
+        if (stop_if_not_finite(*c, pq, c->iterations)) return;
+        if (!(pq < 0) || !(c->rr < -pq * largest_step)) {
+            if (!c->relative) {
+                c->residual = 0;
+                c->converged = c->found = 1;
+                c->active = 0;
+            } else {
+                c->checking = 1;
+            }
+            return;
+        }
+        c->alpha = c->rr / pq;
+        c->stepping = 1;
+    }
+};
+
+/// After a step (sum2: the new r.r; sum: the sum of r in the singular case; change: the
+/// normalized change's parts): the criterion, and the next direction's beta.
+struct cg_after_step {
+    poisson_control* c;
+    int singular;
+    double cells;
+
+    SPHERE_HD void operator()(std::size_t) const
+    {
+        if (!c->stepping) return;
+        ++c->iterations;
+        double rr_new = c->sum2;
+        if (stop_if_not_finite(*c, rr_new, c->iterations)) return;
+        // Singular case: A q has zero mean only to round-off, so r picks up a constant that no
+        // step can remove; it is projected out (r -= mean(r), applied with the next direction;
+        // ||r - m||^2 = r.r - N m^2).
+        double mean = 0;
+        if (singular) {
+            mean = c->sum / cells;
+            rr_new -= cells * mean * mean;
+            if (rr_new < 0) rr_new = 0;
+        }
+        if (c->relative) {
+            if (sqrt(rr_new) <= c->threshold) {
+                c->checking = 1;
+                return;
+            }
+        } else {
+            c->residual = normalized_change_value(c->change);
+            if (stop_if_not_finite(*c, c->residual, c->iterations)) return;
+            if (c->residual <= c->tolerance) {
+                c->converged = c->found = 1;
+                c->active = 0;
+                return;
+            }
+        }
+        c->beta = rr_new / c->rr;
+        c->rr = rr_new;
+        c->mean = mean;
+        c->directing = 1;
+    }
+};
+
+/// After the true residual (sum: its square): converged, stalled at the round-off floor (three
+/// checks in a row that did not halve the best residual), or a restart from it.
+struct cg_after_check {
+    poisson_control* c;
+    SPHERE_HD void operator()(std::size_t) const
+    {
+        if (!c->checking) return;
+        const double res = sqrt(c->sum);
+        c->residual = c->b_norm > 0 ? res / c->b_norm : res;
+        if (stop_if_not_finite(*c, c->residual, c->iterations)) return;
+        if (c->residual <= c->tolerance) {
+            c->converged = c->found = 1;
+            c->active = 0;
+            return;
+        }
+        if (c->residual < 0.5 * c->best) {
+            c->best = c->residual;
+            c->stalls = 0;
+        } else if (++c->stalls >= 3) {
+            c->active = 0;
+            return;
+        }
+        c->restarting = 1;
+    }
+};
+
+/// A restart's mean of r (sum: its sum over the cells).
+struct cg_restart_mean {
+    poisson_control* c;
+    double cells;
+    SPHERE_HD void operator()(std::size_t) const
+    {
+        if (c->restarting) c->mean = c->sum / cells;
+    }
+};
+
+/// The end of a restart: r.r (sum2).
+struct cg_after_restart {
+    poisson_control* c;
+    SPHERE_HD void operator()(std::size_t) const
+    {
+        if (!c->restarting) return;
+        c->rr = c->sum2;
+        c->restarting = 0;
     }
 };
 
@@ -140,12 +270,19 @@ struct cg_direction {
 /// sweep); it measures stagnation, and CG's steps are not monotone, so relative_residual is
 /// the criterion to use with this solver.
 ///
+/// The loop runs on the device without waiting (detail::poisson_control): each pass is the
+/// body of the loop above, its branches decided by one-thread kernels and taken by kernels
+/// guarded by the control's flags; `solve` launches as many passes as the last solve needed
+/// and a quarter more, reads the control back once, and only launches more (doubling) if the
+/// solve had not finished. On the host a guarded kernel whose flag is 0 is not started.
+///
 /// Owns three scratch fields (residual r, direction p, A p), allocated once.
 template <class Real, class Policy>
 class cg_poisson {
 public:
     explicit cg_poisson(const fluid_grid<Real>& g)
-        : problem_(g), r_(g.field_size(), Real(0)), p_(g.field_size(), Real(0)), q_(g.field_size(), Real(0))
+        : problem_(g), r_(g.field_size(), Real(0)), p_(g.field_size(), Real(0)), q_(g.field_size(), Real(0)),
+          control_(1)
     {
     }
 
@@ -154,147 +291,118 @@ public:
     /// Solves A eps = rhs; the same contract as jacobi_poisson::solve.
     poisson_result solve(Real* eps, const Real* rhs, const poisson_boundaries& bc, const poisson_settings& st)
     {
+        return detail::solve_and_wait(*this, context_, control_, eps, rhs, bc, st);
+    }
+
+    /// Launches a solve without reading anything back; the same contract as
+    /// jacobi_poisson::launch.
+    void launch(execution_context<Policy>& ctx, detail::poisson_control* c, const int* hold, Real* eps,
+                const Real* rhs, const poisson_boundaries& bc, const poisson_settings& st)
+    {
         problem_.prepare(bc, st);
-        problem_.fill_ghosts(eps);
-        problem_.remove_means(eps, rhs);
+        ctx_ = &ctx;
+        c_ = c;
+        eps_ = eps;
+        rhs_ = rhs;
+        problem_.start(ctx, c, hold, st, eps, rhs, true);
+        // r and p are zeroed first: their Dirichlet layers must be 0 (only unknowns are
+        // written), and the previous solve may have had other boundaries.
+        problem_.zero(r_.data());
+        problem_.zero(p_.data());
+        restart();
+        passes_ = budget_.passes;
+        run_passes();
+    }
+
+    /// Launches more passes of the last launch (twice as many as the last time) and its end.
+    void resume(execution_context<Policy>&)
+    {
+        passes_ *= 2;
+        run_passes();
+    }
+
+    /// The result of a finished solve from the host's copy of its control (throws its
+    /// error); the passes it used set the next solve's budget.
+    poisson_result learn(const detail::poisson_control& c)
+    {
+        budget_.learn(c.passes);
+        return detail::result_of(c);
+    }
+
+private:
+    void run_passes()
+    {
+        for (unsigned i = 0; i < passes_; ++i) pass();
+        problem_.conclude(*ctx_, c_, eps_, rhs_, nullptr, true, true);
+    }
+
+    /// One pass of the loop (see the class comment).
+    void pass()
+    {
+        detail::poisson_control* c = c_;
+        execution_context<Policy>& ctx = *ctx_;
         const detail::poisson_stencil<Real>& s = problem_.stencil();
-        const bool relative = st.criterion == poisson_criterion::relative_residual;
-        const double b_norm = relative ? problem_.rhs_norm(eps, rhs) : 0.0;
+        Real* r = r_.data();
+        Real* p = p_.data();
+        Real* q = q_.data();
         // |alpha| <= 1 / (smallest non-zero |eigenvalue|) for a direction in the range of A,
         // so |alpha| lambda_max is at most the condition number; a step beyond 1 / epsilon is
         // a direction that A does not see (round-off), never a useful step.
         const double lambda_max = 4 * (s.cx + s.cy + s.cz);
         const double largest_step = 1 / (lambda_max * 2.220446049250313e-16);
         const double cells = double(grid().cell_count());
-        Real* r = r_.data();
-        Real* p = p_.data();
-        Real* q = q_.data();
 
-        poisson_result result;
-        // The criterion on the initial guess.
-        {
-            const double res = problem_.residual_norm(eps, rhs);
-            problem_.check_finite(res, 0);
-            if (relative) {
-                result.residual = b_norm > 0 ? res / b_norm : res;
-                problem_.check_finite(result.residual, 0);
-            }
-            if (relative ? result.residual <= st.tolerance : res == 0) {
-                result.converged = true;
-                problem_.finish(eps);
-                return result;
-            }
-        }
-        // r = p = b - A eps. r and p are zeroed first: their Dirichlet layers must be 0 (only
-        // unknowns are written), and the previous solve may have had other boundaries.
-        problem_.zero(r);
-        problem_.zero(p);
-        const double threshold = st.tolerance * (b_norm > 0 ? b_norm : 1.0);
-        double rr = restart(eps, rhs);
-        bool found = false;
-        // With relative_residual: the true residual of eps, decides convergence; false when
-        // CG should stop (converged, or the residual is at its round-off floor: `stalls`
-        // restarts in a row did not halve the best true residual).
-        double best = result.residual;
-        unsigned stalls = 0;
-        auto check = [&]() {
-            problem_.fill_ghosts(eps);
-            const double res = problem_.residual_norm(eps, rhs);
-            result.residual = b_norm > 0 ? res / b_norm : res;
-            problem_.check_finite(result.residual, result.iterations);
-            if (result.residual <= st.tolerance) {
-                result.converged = true;
-                found = true;
-                return false;
-            }
-            if (result.residual < 0.5 * best) {
-                best = result.residual;
-                stalls = 0;
-            } else if (++stalls >= 3) {
-                return false;
-            }
-            rr = restart(eps, rhs);
-            return true;
-        };
-        while (result.iterations < st.max_iterations) {
-            problem_.fill_ghosts(p);
-            problem_.for_each_unknown(detail::poisson_apply<Real>{s, Real(s.cx), Real(s.cy), Real(s.cz), p, q});
-            const double pq = problem_.sum_unknowns(detail::poisson_dot<Real>{p, q});
-            problem_.check_finite(pq, result.iterations);
-            if (!(pq < 0) || !(rr < -pq * largest_step)) {
-                // p.Ap ~ 0: p has no component that A sees (r is at round-off); a step would be
-                // huge and meaningless. Take none: check the true residual, restart from it.
-                if (!relative) {
-                    result.residual = 0;
-                    result.converged = true;
-                    found = true;
-                    break;
-                }
-                if (check()) continue;
-                break;
-            }
-            const double alpha = rr / pq;
-            problem_.for_each_unknown(detail::cg_step<Real>{Real(alpha), p, q, eps, r});
-            ++result.iterations;
-            double rr_new = problem_.sum_unknowns(detail::poisson_dot<Real>{r, r});
-            problem_.check_finite(rr_new, result.iterations);
-            // Singular case: A q has zero mean only to round-off, so r picks up a constant that
-            // no step can remove; it is projected out (r -= mean(r), applied with the next
-            // direction; ||r - m||^2 = r.r - N m^2).
-            double mean = 0;
-            if (problem_.singular()) {
-                mean = problem_.sum_unknowns(detail::field_cell_value<Real>{r}) / cells;
-                rr_new -= cells * mean * mean;
-                if (rr_new < 0) rr_new = 0;
-            }
-            if (relative) {
-                if (std::sqrt(rr_new) <= threshold) {
-                    if (check()) continue;
-                    break;
-                }
-            } else {
-                result.residual = problem_.normalized_change(eps, nullptr, p, alpha);
-                problem_.check_finite(result.residual, result.iterations);
-                if (result.residual <= st.tolerance) {
-                    result.converged = true;
-                    found = true;
-                    break;
-                }
-            }
-            const double beta = rr_new / rr;
-            rr = rr_new;
-            problem_.for_each_unknown(detail::cg_direction<Real>{Real(beta), Real(mean), r, p});
-        }
-        if (!found && relative) {
-            problem_.fill_ghosts(eps);
-            const double res = problem_.residual_norm(eps, rhs);
-            result.residual = b_norm > 0 ? res / b_norm : res;
-            problem_.check_finite(result.residual, result.iterations);
-            result.converged = result.residual <= st.tolerance;
-        }
-        problem_.finish(eps);
-        return result;
+        for_each_index(Policy{}, 1, detail::cg_begin_pass{c});
+        problem_.fill_ghosts(p, &c->iterate);
+        problem_.for_each_unknown(&c->iterate, detail::poisson_apply<Real>{s, Real(s.cx), Real(s.cy), Real(s.cz), p, q});
+        problem_.sum_unknowns_into(ctx, &c->iterate, detail::poisson_dot<Real>{p, q}, &c->sum);
+        for_each_index(Policy{}, 1, detail::cg_after_apply{c, largest_step});
+
+        problem_.for_each_unknown(&c->stepping, detail::cg_step<Real>{c, p, q, eps_, r});
+        problem_.sum_unknowns_into(ctx, &c->stepping, detail::poisson_dot<Real>{r, r}, &c->sum2);
+        if (problem_.singular())
+            problem_.sum_unknowns_into(ctx, &c->stepping, detail::field_cell_value<Real>{r}, &c->sum);
+        if (!problem_.relative())
+            problem_.normalized_change_into(ctx, &c->stepping, eps_, nullptr, p, &c->alpha, &c->change);
+        for_each_index(Policy{}, 1, detail::cg_after_step{c, problem_.singular() ? 1 : 0, cells});
+        problem_.for_each_unknown(&c->directing, detail::cg_direction<Real>{c, r, p});
+
+        problem_.fill_ghosts(eps_, &c->checking);
+        problem_.residual_squared_into(ctx, &c->checking, eps_, rhs_, c, &c->sum);
+        for_each_index(Policy{}, 1, detail::cg_after_check{c});
+        restart();
     }
 
-private:
-    /// r = p = b - A eps (eps's ghosts are refreshed first), with its mean removed in the
-    /// singular case; returns r.r.
-    double restart(Real* eps, const Real* rhs)
+    /// Where c->restarting: r = p = b - A eps (eps's ghosts are refreshed first), with its mean
+    /// removed in the singular case; rr = r.r.
+    void restart()
     {
-        const detail::poisson_stencil<Real>& s = problem_.stencil();
-        problem_.fill_ghosts(eps);
-        problem_.for_each_unknown(detail::poisson_residual_field<Real>{s, eps, rhs, problem_.shift(), r_.data()});
+        detail::poisson_control* c = c_;
+        execution_context<Policy>& ctx = *ctx_;
+        const int* go = &c->restarting;
+        problem_.fill_ghosts(eps_, go);
+        problem_.for_each_unknown(go, detail::poisson_residual_field<Real>{problem_.stencil(), eps_, rhs_, &c->shift,
+                                                                            r_.data()});
         if (problem_.singular()) {
-            const double mean =
-                problem_.sum_unknowns(detail::field_cell_value<Real>{r_.data()}) / double(grid().cell_count());
-            problem_.for_each_unknown(detail::subtract_from_cells<Real>{r_.data(), Real(mean)});
+            problem_.sum_unknowns_into(ctx, go, detail::field_cell_value<Real>{r_.data()}, &c->sum);
+            for_each_index(Policy{}, 1, detail::cg_restart_mean{c, double(grid().cell_count())});
+            problem_.for_each_unknown(go, detail::subtract_from_cells<Real>{r_.data(), &c->mean});
         }
-        problem_.copy(r_.data(), p_.data());
-        return problem_.sum_unknowns(detail::poisson_dot<Real>{r_.data(), r_.data()});
+        problem_.copy(r_.data(), p_.data(), go);
+        problem_.sum_unknowns_into(ctx, go, detail::poisson_dot<Real>{r_.data(), r_.data()}, &c->sum2);
+        for_each_index(Policy{}, 1, detail::cg_after_restart{c});
     }
 
     detail::poisson_problem<Real, Policy> problem_;
     buffer<Real, Policy> r_, p_, q_;
+    buffer<detail::poisson_control, Policy> control_; ///< solve()'s control
+    execution_context<Policy> context_;                ///< solve()'s context
+    detail::poisson_budget budget_;
+    unsigned passes_ = 0;
+    execution_context<Policy>* ctx_ = nullptr;
+    detail::poisson_control* c_ = nullptr;
+    Real* eps_ = nullptr;
+    const Real* rhs_ = nullptr;
 };
 
 } // namespace sphere

@@ -204,12 +204,18 @@ public:
     /// periodic axis is too short for the cell spheres (see the class comment).
     void update(const particle_view<Real>& p, Real dt)
     {
+        update(p, dt,
+               p.n == 0 ? Real(0)
+                        : transform_reduce(Policy{}, p.n, detail::particle_radius<Real>{p.x}, Real(0), max_op{}));
+    }
+
+    /// `update` with the largest particle radius r_max (m) given (a simulation knows it on the
+    /// host), so that nothing is read back from the device.
+    void update(const particle_view<Real>& p, Real dt, Real r_max)
+    {
         if (!(dt > Real(0)) || !std::isfinite(dt))
             detail::fail("porosity_estimator::update: dt = ", dt, " s must be positive and finite");
         const Real R = cell_sphere_radius();
-        const Real r_max =
-            p.n == 0 ? Real(0)
-                     : transform_reduce(Policy{}, p.n, detail::particle_radius<Real>{p.x}, Real(0), max_op{});
         const char* axis_name[3] = {"x", "y", "z"};
         for (int a = 0; a < 3; ++a)
             if (grid_.box.periodic(a) && R + r_max > grid_.box.length(a) / Real(2))
