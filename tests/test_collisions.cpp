@@ -786,3 +786,54 @@ TEMPLATE_TEST_CASE("mass-scaled damping: each pair gets c = gamma m*, so its res
     REQUIRE_THROWS_WITH((test_sim<P>(s, {ball<Real>({0, 0, 0})})),
                         Catch::Contains("settings.contact.gamma_n = -1 1/s (mass-scaled): must be non-negative"));
 }
+
+// ---------------------------------------------------------------------------------------------
+// Damping ratios (damping_convention::damping_ratio): c = 2 zeta sqrt(m* k_n) per contact.
+// ---------------------------------------------------------------------------------------------
+TEMPLATE_TEST_CASE("damping ratios: every pair has the restitution its ratio gives, whatever its masses",
+                   "[collision][damping]", float, double, sphere::mixed)
+{
+    using P = TestType;
+    using Real = user_real<P>;
+    // Head-on pairs of unlike radii and densities at 1 m/s, at dt/10: with gamma_n = damping_ratio_from_restitution(0.5, tension) every contact rebounds
+    // with e = 0.5, with and without tension (the linear law's restitution depends on its
+    // damping ratio alone: docs/physics.md, "Restitution"). Tolerance 0.5% (VALIDATION D2 at
+    // dt/10; the stiffest pair sets dt).
+    struct pair_case {
+        double r_a, r_b, rho_a, rho_b;
+    };
+    for (bool tension : {true, false}) {
+        CAPTURE(tension);
+        const double zeta = sphere::damping_ratio_from_restitution(0.5, tension);
+        for (const pair_case pc : {pair_case{0.01, 0.01, 2500, 2500}, pair_case{0.02, 0.01, 2500, 2500},
+                                   pair_case{0.015, 0.008, 1000, 7800}}) {
+            const double m_a = sphere::sphere_mass(pc.r_a, pc.rho_a), m_b = sphere::sphere_mass(pc.r_b, pc.rho_b);
+            const double m_eff = m_a * m_b / (m_a + m_b);
+            sphere::settings<Real> s = box_settings<Real>();
+            s.contact.gamma_n = Real(zeta);
+            s.contact.damping = sphere::damping_convention::damping_ratio;
+            s.contact.tension = tension;
+            s.dt = Real(dt_p / 10);
+            const Real gap = Real(1e-4);
+            auto a = ball<Real>({-(Real(pc.r_a) + gap / 2), 0, 0}, {1, 0, 0}, Real(pc.r_a));
+            auto b = ball<Real>({Real(pc.r_b) + gap / 2, 0, 0}, {0, 0, 0}, Real(pc.r_b));
+            a.density = Real(pc.rho_a);
+            b.density = Real(pc.rho_b);
+            test_sim<P> sim(s, {a, b});
+            const double c_n = 2 * zeta * std::sqrt(m_eff * k_n_p);
+            const contact_record c =
+                watch_collision(sim, [](const auto& snap) { return pair_state(snap); }, k_n_p, c_n, tension, 400000);
+            REQUIRE(c.separated);
+            const auto snap = sim.snapshot();
+            const double e = double(snap.v[1].x) - double(snap.v[0].x);
+            INFO("radii " << pc.r_a << ", " << pc.r_b << " m, m* = " << m_eff << " kg: e = " << e);
+            CHECK(rel_err(e, 0.5) < 5e-3);
+        }
+    }
+    // The validation names the convention's unit.
+    sphere::settings<Real> s = box_settings<Real>();
+    s.contact.damping = sphere::damping_convention::damping_ratio;
+    s.contact.gamma_t = Real(-1);
+    REQUIRE_THROWS_WITH((test_sim<P>(s, {ball<Real>({0, 0, 0})})),
+                        Catch::Contains("settings.contact.gamma_t = -1 (ratio to critical damping): must be non-negative"));
+}

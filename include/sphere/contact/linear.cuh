@@ -94,8 +94,13 @@ private:
                                                    vec4<Real>& h, Real dt)
     {
         contact_params<Real> p = given;
-        // gamma in 1/s when mass-scaled: c = gamma m_eff (N s/m)
-        const Real scale = p.damping == damping_convention::mass_scaled ? m.m_eff : Real(1);
+        // gamma in 1/s when mass-scaled: c = gamma m_eff; a ratio to critical damping:
+        // c = 2 gamma sqrt(m_eff k_n) (N s/m; docs/physics.md, "Normal force")
+        Real scale = Real(1);
+        if (p.damping == damping_convention::mass_scaled)
+            scale = m.m_eff;
+        else if (p.damping == damping_convention::damping_ratio)
+            scale = Real(2) * std::sqrt(m.m_eff * p.k_n);
         p.gamma_n *= scale;
         p.gamma_t *= scale;
         const vec3<Real>& n = m.n;
@@ -127,10 +132,12 @@ private:
         positive(p.k_n, "k_n", "N/m");
         non_negative(p.k_t, "k_t", "N/m");
         const bool scaled = p.damping == damping_convention::mass_scaled;
-        if (p.damping != damping_convention::absolute && !scaled)
+        const bool ratio = p.damping == damping_convention::damping_ratio;
+        if (p.damping != damping_convention::absolute && !scaled && !ratio)
             detail::fail(where, ".damping = ", unsigned(p.damping), ": not a damping_convention");
-        non_negative(p.gamma_n, "gamma_n", scaled ? "1/s (mass-scaled)" : "N s/m");
-        non_negative(p.gamma_t, "gamma_t", scaled ? "1/s (mass-scaled)" : "N s/m");
+        const char* unit = scaled ? "1/s (mass-scaled)" : (ratio ? "(ratio to critical damping)" : "N s/m");
+        non_negative(p.gamma_n, "gamma_n", unit);
+        non_negative(p.gamma_t, "gamma_t", unit);
         non_negative(p.mu_s, "mu_s", "(friction)");
         non_negative(p.mu_d, "mu_d", "(friction)");
         if (p.mu_d > p.mu_s)

@@ -10,6 +10,8 @@ enum class damping_convention : std::uint8_t {
     absolute = 0,    ///< in N s/m, the same for every contact (sphere's convention)
     mass_scaled = 1, ///< in 1/s, multiplied by the contact's effective mass m_eff (kg): the
                      ///< convention of LAMMPS gran/hooke and LIGGGHTS (docs/physics.md, "Normal force")
+    damping_ratio = 2, ///< dimensionless ratios zeta to critical damping: c = 2 zeta sqrt(m_eff k_n), so
+                       ///< every pair has the same restitution whatever its masses (damping_ratio_from_restitution)
 };
 
 /// Linear elastic-viscous contact parameters, SI units (docs/physics.md, "Contact model").
@@ -18,8 +20,8 @@ template <class Real>
 struct contact_params {
     Real k_n = 0;      ///< normal stiffness (N/m), > 0
     Real k_t = 0;      ///< tangential stiffness (N/m), > 0 for elastic tangential laws
-    Real gamma_n = 0;  ///< normal viscosity, >= 0: N s/m, or 1/s when mass-scaled
-    Real gamma_t = 0;  ///< tangential viscosity, >= 0: N s/m, or 1/s when mass-scaled
+    Real gamma_n = 0;  ///< normal viscosity, >= 0: N s/m, 1/s when mass-scaled, or a damping ratio
+    Real gamma_t = 0;  ///< tangential viscosity, >= 0: N s/m, 1/s when mass-scaled, or a damping ratio
     Real mu_s = 0;     ///< static friction coefficient, >= 0
     Real mu_d = 0;     ///< dynamic friction coefficient, 0 <= mu_d <= mu_s
     bool tension = false; ///< allow an attractive normal force (false: clipped at 0, as sphere does)

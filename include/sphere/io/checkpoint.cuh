@@ -226,7 +226,7 @@ public:
         p.mu_s = Real(f64(what));
         p.mu_d = Real(f64(what));
         p.tension = choice(what, 1) == 1;
-        p.damping = static_cast<damping_convention>(choice(what, 1));
+        p.damping = static_cast<damping_convention>(choice(what, 2));
         return p;
     }
     /// An array of `expected` elements of `element_bytes` bytes each, read by `get`.
