@@ -269,3 +269,34 @@ TEMPLATE_TEST_CASE("set_wall_position moves a wall onto the sample and refuses i
     sim.run(std::size_t(0.02 / double(sim.dt())));
     CHECK(sim.walls().face[5].force > 0);
 }
+
+TEMPLATE_TEST_CASE("between two walls a sphere creeps at m g / (2 gamma_wt) under the visco-frictional wall law and "
+                   "rests under the elastic one",
+                   "[walls]", float, double)
+{
+    // docs/physics.md, "Which wall law for a static load": a set-P sphere pressed by 0.1 mm
+    // into each of two walls x = -+(R - 0.1 mm) (f_n = 10 N, mu_w f_n = 3 N far above its
+    // weight m g = 0.103 N), under gravity, from rest. The visco-frictional wall law carries
+    // the weight only while the sphere slides: it settles (in m / (2 gamma_wt) = 2.6 ms) to
+    // v_z = -m g / (2 gamma_wt) = -0.0257 m/s (1%). The elastic law's spring holds it: after
+    // 0.05 s |v_z| is below 1e-3 of that creep.
+    using Real = TestType;
+    const Real R = set_p<Real>::radius, press = Real(1e-4);
+    sphere::settings<Real> s = sphere_test::frictional_box<Real>(1.0);
+    s.box.lo.x = -(R - press);
+    s.box.hi.x = R - press;
+    const double m = double(sphere::sphere_mass(R, set_p<Real>::density));
+    const double creep = m * 9.81 / (2 * double(s.wall.gamma_t));
+    const std::vector<sphere::particle<Real>> p{sphere_test::ball<Real>({0, 0, 0})};
+    sphere::simulation<Real, sphere_test::policy> creeping(s, p);
+    using elastic_walls =
+        sphere::contact::linear<sphere::tangential::elastic_viscous_frictional, sphere::tangential::elastic_viscous_frictional>;
+    sphere::simulation<Real, sphere_test::policy, elastic_walls> resting(s, p);
+    const std::size_t steps = std::size_t(0.05 / double(creeping.dt()));
+    creeping.run(steps);
+    resting.run(steps);
+    const double v_creep = double(creeping.snapshot().v[0].z), v_rest = double(resting.snapshot().v[0].z);
+    INFO("creeping v_z = " << v_creep << " m/s (expected " << -creep << "), resting v_z = " << v_rest << " m/s");
+    CHECK(v_creep == Approx(-creep).epsilon(0.01));
+    CHECK(std::fabs(v_rest) < 1e-3 * creep);
+}
