@@ -14,7 +14,8 @@
 //   (what the lists' 32-bit offsets hold) is found on the device and reported as an error;
 // - a pressure solve reads its control back once when it needs no more passes than the last
 //   one and a quarter; a fluid step (with either solver) reads back once and allocates
-//   nothing after warm-up; a coupled step reads back once more than its DEM steps do.
+//   nothing after warm-up; a coupled step reads back once more than its DEM steps do, also
+//   with velocity Verlet (whose check of the next drift comes back with the fluid's report).
 #include <catch2/catch.hpp>
 
 #include <random>
@@ -236,7 +237,9 @@ namespace {
 
 /// A sphere settling in a periodic fluid column (VALIDATION F6's set-up) with a pressure top;
 /// counts the read-backs of a fluid step alone, of dem_steps DEM steps and of a coupled step.
-template <class Real, class Poisson>
+/// Velocity Verlet runs on the gather schedule (CUDA's; on the host's slab schedule its drift
+/// reads its own check back).
+template <class Real, class Poisson, class Integrator = sphere::integrate::semi_implicit_euler>
 void count_coupled_step()
 {
     const double cell = 5e-3;
@@ -250,7 +253,8 @@ void count_coupled_step()
     p.position = {Real(1.5 * cell), Real(1.5 * cell), Real(34.5 * cell)};
     p.radius = Real(5e-4);
     p.density = 2600;
-    sphere::simulation<Real, sphere::host> sim(s, {p});
+    if (Integrator::drifts_before_forces) s.pair_summation = sphere::pair_summation::gather;
+    sphere::simulation<Real, sphere::host, sphere::contact::linear<>, Integrator> sim(s, {p});
     sphere::fluid_params<Real> prm;
     prm.viscosity = Real(0.1);
     prm.gravity = s.gravity;
@@ -294,6 +298,10 @@ TEMPLATE_TEST_CASE("device activity: a fluid step reads back once, a coupled ste
     using Real = TestType;
     SECTION("conjugate gradients") { count_coupled_step<Real, sphere::cg_poisson<Real, sphere::host>>(); }
     SECTION("Jacobi") { count_coupled_step<Real, sphere::jacobi_poisson<Real, sphere::host>>(); }
+    SECTION("velocity Verlet")
+    {
+        count_coupled_step<Real, sphere::cg_poisson<Real, sphere::host>, sphere::integrate::velocity_verlet>();
+    }
 }
 
 TEST_CASE("device activity: a rebuild whose entries wrap the 32-bit offsets is an error", "[activity]")

@@ -417,6 +417,48 @@ public:
         return external_.data();
     }
 
+    /// For a caller that has just written the external forces and waits for the device before
+    /// the next step anyway (the pore-fluid coupling, with its fluid step's report): launches
+    /// the check of where the next drift will put the particles (as a step's end does,
+    /// detail::check_after_drift) into `out` (policy memory, nothing read back) and returns
+    /// true; returns false where the next drift checks itself (an integrator that drifts after
+    /// the forces, or the host's slab schedule). Hand the value, read back, to drift_checked(),
+    /// and the next drift need not wait for its own check.
+    bool predict_drift_into(Coord* out)
+    {
+        if constexpr (!Integrator::drifts_before_forces) {
+            (void)out;
+            return false;
+        } else {
+            if (!predicts_drift()) return false;
+            const stream_scope<Policy> on_stream(context_);
+            if (external_.size())
+                predict_drift_with<true>(out);
+            else
+                predict_drift_with<false>(out);
+            return true;
+        }
+    }
+
+    /// The check of the next drift, with or without external forces (predict_drift_into).
+    template <bool External>
+    void predict_drift_with(Coord* out)
+    {
+        const detail::drift_particles<Precision, Integrator, External> drift{
+            particles_.view(), settings_.box, gravity_, Real(dt_), External ? external_.data() : nullptr};
+        transform_reduce_into(context_, size(), detail::check_after_drift<Precision, Integrator, External>{drift, check()},
+                              Coord(0), max_op{}, out);
+    }
+
+    /// Takes the check that predict_drift_into wrote, read back (the largest squared
+    /// displacement after the next drift): a finite one decides the next rebuild now, and the
+    /// drift does not check itself; a bad particle is left for the drift's own check to name.
+    void drift_checked(Coord moved2)
+    {
+        drift_checked_ = std::isfinite(moved2);
+        if (drift_checked_) judge(moved2, steps_ + 1, drift_margin_);
+    }
+
     /// Kinetic, rotational, potential and elastic energies and the dissipated energies (J),
     /// summed in rank order (the same bits whatever the storage order).
     energy_budget<Coord> energy() const

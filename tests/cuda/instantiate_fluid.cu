@@ -1,6 +1,7 @@
 // Instantiates every kernel of the pore fluid for sphere::cuda in float and double: the
 // porosity estimator, both Poisson solvers, the Navier-Stokes solver with each, and the
-// coupling with each drag law, so that CI proves the fluid's CUDA backend compiles and links.
+// coupling with each drag law (and once with velocity Verlet, whose coupled step predicts its
+// next drift), so that CI proves the fluid's CUDA backend compiles and links.
 // It is built, not run: build machines have no GPU.
 #include <sphere/dem.cuh>
 #include <sphere/fluid.cuh>
@@ -10,7 +11,7 @@
 
 namespace {
 
-template <class Real, class Drag, class Poisson>
+template <class Real, class Drag, class Poisson, class Integrator = sphere::integrate::semi_implicit_euler>
 double exercise()
 {
     sphere::settings<Real> s;
@@ -24,7 +25,7 @@ double exercise()
     particles[0].position = {Real(0.0075), Real(0.0075), Real(0.15)};
     particles[0].radius = Real(5e-4);
     particles[0].density = Real(2600);
-    sphere::simulation<Real, sphere::cuda> sim(s, particles);
+    sphere::simulation<Real, sphere::cuda, sphere::contact::linear<>, Integrator> sim(s, particles);
     sphere::fluid_params<Real> prm;
     prm.gravity = s.gravity;
     prm.top = sphere::fluid_boundary<Real>::prescribed_pressure(0);
@@ -42,7 +43,8 @@ double exercise_all()
     using jacobi = sphere::jacobi_poisson<Real, sphere::cuda>;
     using cg = sphere::cg_poisson<Real, sphere::cuda>;
     return exercise<Real, drag::gidaspow, jacobi>() + exercise<Real, drag::gidaspow_blended, cg>() +
-           exercise<Real, drag::ergun, cg>() + exercise<Real, drag::wen_yu, jacobi>();
+           exercise<Real, drag::ergun, cg>() + exercise<Real, drag::wen_yu, jacobi>() +
+           exercise<Real, drag::gidaspow, cg, sphere::integrate::velocity_verlet>();
 }
 
 } // namespace

@@ -18,7 +18,8 @@
 ///      particles (force times displacement) is added to work_on_particles().
 /// The checks (porosity, response time, stability, the pressure solve) are taken on the device
 /// and read back once, with the fluid step's report, before the DEM steps: a coupled step
-/// waits for the device once more than its dem_steps DEM steps do.
+/// waits for the device once more than its dem_steps DEM steps do (also with velocity Verlet,
+/// whose check of its next drift, which the new forces change, comes back with that report).
 /// The forces are explicit: dt_f must not exceed the shortest particle response time
 /// m_i / (beta_per_solid V_i) (checked; the step throws naming the particle).
 #include <cstddef>
@@ -182,12 +183,16 @@ public:
                               &report->response);
         for_each_index(Policy{}, fluid_.grid().cell_count(),
                        detail::fluid_reaction<Real>{fluid_.view(), porosity_.bins(), forces});
+        // New forces change where a drift-first integrator's next drift goes: its check comes
+        // back with the fluid's report instead of with a read-back of its own.
+        const bool predicted = sim.predict_drift_into(&report->next_drift);
         const detail::fluid_report<Real>& found = fluid_.advance(dt);
         if (found.hold == detail::fluid_hold_response)
             detail::fail("coupling: the fluid step ", dt, " s (", options_.dem_steps, " DEM steps of ", sim.dt(),
                          " s) exceeds the shortest particle response time m / (drag coefficient) = ", found.response,
                          " s; use fewer DEM steps per fluid step");
         fluid_.check(found, dt);
+        if (predicted) sim.drift_checked(found.next_drift);
         if (x_before_.size() != p.n) x_before_ = buffer<vec4<Real>, Policy>(p.n);
         for_each_index(Policy{}, p.n, detail::positions_by_user<Real>{p, x_before_.data()});
         sim.run(options_.dem_steps);

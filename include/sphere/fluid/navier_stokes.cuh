@@ -355,6 +355,7 @@ struct fluid_report {
     Real limit;           ///< the stability limit (s)
     int hold;             ///< fluid_hold
     int commit;           ///< the solve converged and nothing held: the fields advance
+    Real next_drift;      ///< the coupling's: the simulation's check of its next drift (predict_drift_into)
     double work_step;     ///< the coupling's: the fluid's work on the particles in the last step (J)
     double work_total;    ///< and its sum (J)
 };
