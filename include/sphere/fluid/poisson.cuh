@@ -863,20 +863,82 @@ struct poisson_budget {
     void learn(unsigned used) { passes = used + used / 4 + 4 < 16 ? 16 : used + used / 4 + 4; }
 };
 
-/// The solve() of both solvers: launch, read the control back, resume until it finished.
-template <class Solver, class Real, class Policy>
-poisson_result solve_and_wait(Solver& solver, execution_context<Policy>& ctx, buffer<poisson_control, Policy>& control,
-                              Real* eps, const Real* rhs, const poisson_boundaries& bc, const poisson_settings& st)
-{
-    solver.launch(ctx, control.data(), nullptr, eps, rhs, bc, st);
-    poisson_control c{};
-    ctx.read_back(&c, control.data(), 1, "the Poisson solve's control", 0);
-    while (!c.finished) {
-        solver.resume(ctx);
-        ctx.read_back(&c, control.data(), 1, "the Poisson solve's control", 0);
+/// What both solvers share (CRTP: `Derived` is jacobi_poisson or cg_poisson): the problem,
+/// the control and context of solve(), the pass budget and the pointers of the launch in
+/// progress. Derived provides `static constexpr bool restarts` (poisson_problem::start's
+/// restart), `begin()` (its fields' set-up after start) and `run_passes()` (passes_ passes,
+/// then problem_.conclude).
+template <class Derived, class Real, class Policy>
+class poisson_solver_base {
+public:
+    const fluid_grid<Real>& grid() const { return problem_.grid(); }
+
+    /// Solves A eps = rhs (jacobi_poisson's comment): launch, read the control back, resume
+    /// until it finished. eps and rhs point to fields of grid().field_size() entries in the
+    /// Policy's memory space; eps holds the initial guess and the Dirichlet values on entry
+    /// and the solution, with every ghost filled, on return. Throws on bad settings, nz < 3
+    /// with a Dirichlet end, or a residual that becomes NaN or infinite.
+    poisson_result solve(Real* eps, const Real* rhs, const poisson_boundaries& bc, const poisson_settings& st)
+    {
+        launch(context_, control_.data(), nullptr, eps, rhs, bc, st);
+        poisson_control c{};
+        context_.read_back(&c, control_.data(), 1, "the Poisson solve's control", 0);
+        while (!c.finished) {
+            resume(context_);
+            context_.read_back(&c, control_.data(), 1, "the Poisson solve's control", 0);
+        }
+        return learn(c);
     }
-    return solver.learn(c);
-}
+
+    /// Launches a solve (solve's contract) without reading anything back: its state in the
+    /// control `c` (policy memory); nothing runs if *hold (hold may be null). Throws on bad
+    /// settings. When c->finished is 0 after the launch, resume() launches more passes.
+    void launch(execution_context<Policy>& ctx, poisson_control* c, const int* hold, Real* eps, const Real* rhs,
+                const poisson_boundaries& bc, const poisson_settings& st)
+    {
+        problem_.prepare(bc, st);
+        ctx_ = &ctx;
+        c_ = c;
+        eps_ = eps;
+        rhs_ = rhs;
+        problem_.start(ctx, c, hold, st, eps, rhs, Derived::restarts);
+        self().begin();
+        passes_ = budget_.passes;
+        self().run_passes();
+    }
+
+    /// Launches more passes of the last launch (twice as many as the last time) and its end.
+    void resume(execution_context<Policy>&)
+    {
+        passes_ *= 2;
+        self().run_passes();
+    }
+
+    /// The result of a finished solve from the host's copy of its control (throws its
+    /// error); the passes it used set the next solve's budget.
+    poisson_result learn(const poisson_control& c)
+    {
+        budget_.learn(c.passes);
+        return result_of(c);
+    }
+
+protected:
+    explicit poisson_solver_base(const fluid_grid<Real>& g) : problem_(g), control_(1) {}
+
+    poisson_problem<Real, Policy> problem_;
+    unsigned passes_ = 0;                ///< passes of the launch in progress
+    execution_context<Policy>* ctx_ = nullptr;
+    poisson_control* c_ = nullptr;
+    Real* eps_ = nullptr;
+    const Real* rhs_ = nullptr;
+
+private:
+    Derived& self() { return static_cast<Derived&>(*this); }
+
+    buffer<poisson_control, Policy> control_; ///< solve()'s control
+    execution_context<Policy> context_;        ///< solve()'s context
+    poisson_budget budget_;
+};
 
 /// Jacobi decisions of one pass (relative_residual): the criterion of the current iterate
 /// (sum: its squared residual), then a sweep unless converged or at max_iterations.
@@ -953,55 +1015,19 @@ struct jacobi_after_sweep {
 ///                                             sphere::z_boundary::dirichlet}, {});
 ///     if (!r.converged) ...
 template <class Real, class Policy>
-class jacobi_poisson {
+class jacobi_poisson : public detail::poisson_solver_base<jacobi_poisson<Real, Policy>, Real, Policy> {
+    using base = detail::poisson_solver_base<jacobi_poisson<Real, Policy>, Real, Policy>;
+    friend base;
+
 public:
-    explicit jacobi_poisson(const fluid_grid<Real>& g) : problem_(g), scratch_(g.field_size(), Real(0)), control_(1) {}
-
-    const fluid_grid<Real>& grid() const { return problem_.grid(); }
-
-    /// Solves A eps = rhs (file comment). eps and rhs point to fields of grid().field_size()
-    /// entries in the Policy's memory space; eps holds the initial guess and the Dirichlet
-    /// values on entry and the solution, with every ghost filled, on return. Throws on bad
-    /// settings, nz < 3 with a Dirichlet end, or a residual that becomes NaN or infinite.
-    poisson_result solve(Real* eps, const Real* rhs, const poisson_boundaries& bc, const poisson_settings& st)
-    {
-        return detail::solve_and_wait(*this, context_, control_, eps, rhs, bc, st);
-    }
-
-    /// Launches a solve (solve's contract) without reading anything back: its state in the
-    /// control `c` (policy memory); nothing runs if *hold (hold may be null). Throws on bad
-    /// settings. When c->finished is 0 after the launch, resume() launches more passes.
-    void launch(execution_context<Policy>& ctx, detail::poisson_control* c, const int* hold, Real* eps,
-                const Real* rhs, const poisson_boundaries& bc, const poisson_settings& st)
-    {
-        problem_.prepare(bc, st);
-        ctx_ = &ctx;
-        c_ = c;
-        eps_ = eps;
-        rhs_ = rhs;
-        problem_.start(ctx, c, hold, st, eps, rhs, false);
-        // The Dirichlet layers of both fields.
-        problem_.copy(eps, scratch_.data(), &c->active);
-        passes_ = budget_.passes;
-        run_passes();
-    }
-
-    /// Launches more passes of the last launch (twice as many as the last time) and its end.
-    void resume(execution_context<Policy>&)
-    {
-        passes_ *= 2;
-        run_passes();
-    }
-
-    /// The result of a finished solve from the host's copy of its control (throws its
-    /// error); the passes it used set the next solve's budget.
-    poisson_result learn(const detail::poisson_control& c)
-    {
-        budget_.learn(c.passes);
-        return detail::result_of(c);
-    }
+    explicit jacobi_poisson(const fluid_grid<Real>& g) : base(g), scratch_(g.field_size(), Real(0)) {}
 
 private:
+    static constexpr bool restarts = false;
+
+    /// The Dirichlet layers of both fields.
+    void begin() { problem_.copy(eps_, scratch_.data(), &c_->active); }
+
     /// passes_ sweeps (rounded up to pairs, so that a launch that does not finish leaves
     /// the iterate in eps), then the end.
     void run_passes()
@@ -1033,16 +1059,14 @@ private:
         for_each_index(Policy{}, 1, detail::jacobi_after_sweep{c});
     }
 
-    detail::poisson_problem<Real, Policy> problem_;
+    using base::c_;
+    using base::ctx_;
+    using base::eps_;
+    using base::passes_;
+    using base::problem_;
+    using base::rhs_;
+
     buffer<Real, Policy> scratch_;
-    buffer<detail::poisson_control, Policy> control_; ///< solve()'s control
-    execution_context<Policy> context_;                ///< solve()'s context
-    detail::poisson_budget budget_;
-    unsigned passes_ = 0;
-    execution_context<Policy>* ctx_ = nullptr;
-    detail::poisson_control* c_ = nullptr;
-    Real* eps_ = nullptr;
-    const Real* rhs_ = nullptr;
 };
 
 } // namespace sphere

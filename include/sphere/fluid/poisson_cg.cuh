@@ -278,58 +278,28 @@ struct cg_after_restart {
 ///
 /// Owns three scratch fields (residual r, direction p, A p), allocated once.
 template <class Real, class Policy>
-class cg_poisson {
+class cg_poisson : public detail::poisson_solver_base<cg_poisson<Real, Policy>, Real, Policy> {
+    using base = detail::poisson_solver_base<cg_poisson<Real, Policy>, Real, Policy>;
+    friend base;
+
 public:
     explicit cg_poisson(const fluid_grid<Real>& g)
-        : problem_(g), r_(g.field_size(), Real(0)), p_(g.field_size(), Real(0)), q_(g.field_size(), Real(0)),
-          control_(1)
+        : base(g), r_(g.field_size(), Real(0)), p_(g.field_size(), Real(0)), q_(g.field_size(), Real(0))
     {
-    }
-
-    const fluid_grid<Real>& grid() const { return problem_.grid(); }
-
-    /// Solves A eps = rhs; the same contract as jacobi_poisson::solve.
-    poisson_result solve(Real* eps, const Real* rhs, const poisson_boundaries& bc, const poisson_settings& st)
-    {
-        return detail::solve_and_wait(*this, context_, control_, eps, rhs, bc, st);
-    }
-
-    /// Launches a solve without reading anything back; the same contract as
-    /// jacobi_poisson::launch.
-    void launch(execution_context<Policy>& ctx, detail::poisson_control* c, const int* hold, Real* eps,
-                const Real* rhs, const poisson_boundaries& bc, const poisson_settings& st)
-    {
-        problem_.prepare(bc, st);
-        ctx_ = &ctx;
-        c_ = c;
-        eps_ = eps;
-        rhs_ = rhs;
-        problem_.start(ctx, c, hold, st, eps, rhs, true);
-        // r and p are zeroed first: their Dirichlet layers must be 0 (only unknowns are
-        // written), and the previous solve may have had other boundaries.
-        problem_.zero(r_.data());
-        problem_.zero(p_.data());
-        restart();
-        passes_ = budget_.passes;
-        run_passes();
-    }
-
-    /// Launches more passes of the last launch (twice as many as the last time) and its end.
-    void resume(execution_context<Policy>&)
-    {
-        passes_ *= 2;
-        run_passes();
-    }
-
-    /// The result of a finished solve from the host's copy of its control (throws its
-    /// error); the passes it used set the next solve's budget.
-    poisson_result learn(const detail::poisson_control& c)
-    {
-        budget_.learn(c.passes);
-        return detail::result_of(c);
     }
 
 private:
+    static constexpr bool restarts = true;
+
+    /// r and p are zeroed first: their Dirichlet layers must be 0 (only unknowns are written),
+    /// and the previous solve may have had other boundaries.
+    void begin()
+    {
+        problem_.zero(r_.data());
+        problem_.zero(p_.data());
+        restart();
+    }
+
     void run_passes()
     {
         for (unsigned i = 0; i < passes_; ++i) pass();
@@ -350,7 +320,7 @@ private:
         // a direction that A does not see (round-off), never a useful step.
         const double lambda_max = 4 * (s.cx + s.cy + s.cz);
         const double largest_step = 1 / (lambda_max * 2.220446049250313e-16);
-        const double cells = double(grid().cell_count());
+        const double cells = double(problem_.grid().cell_count());
 
         for_each_index(Policy{}, 1, detail::cg_begin_pass{c});
         problem_.fill_ghosts(p, &c->iterate);
@@ -385,7 +355,7 @@ private:
                                                                             r_.data()});
         if (problem_.singular()) {
             problem_.sum_unknowns_into(ctx, go, detail::field_cell_value<Real>{r_.data()}, &c->sum);
-            for_each_index(Policy{}, 1, detail::cg_restart_mean{c, double(grid().cell_count())});
+            for_each_index(Policy{}, 1, detail::cg_restart_mean{c, double(problem_.grid().cell_count())});
             problem_.for_each_unknown(go, detail::subtract_from_cells<Real>{r_.data(), &c->mean});
         }
         problem_.copy(r_.data(), p_.data(), go);
@@ -393,16 +363,14 @@ private:
         for_each_index(Policy{}, 1, detail::cg_after_restart{c});
     }
 
-    detail::poisson_problem<Real, Policy> problem_;
+    using base::c_;
+    using base::ctx_;
+    using base::eps_;
+    using base::passes_;
+    using base::problem_;
+    using base::rhs_;
+
     buffer<Real, Policy> r_, p_, q_;
-    buffer<detail::poisson_control, Policy> control_; ///< solve()'s control
-    execution_context<Policy> context_;                ///< solve()'s context
-    detail::poisson_budget budget_;
-    unsigned passes_ = 0;
-    execution_context<Policy>* ctx_ = nullptr;
-    detail::poisson_control* c_ = nullptr;
-    Real* eps_ = nullptr;
-    const Real* rhs_ = nullptr;
 };
 
 } // namespace sphere
