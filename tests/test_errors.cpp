@@ -408,8 +408,10 @@ TEMPLATE_TEST_CASE("the time step must be positive, finite and within the stable
             s.dt = Real(1.01 * bound);
             REQUIRE_SPHERE_ERROR(build(s, ps),
                                  Contains("settings.dt = " + fmt(s.dt) +
-                                          " s exceeds the stable bound 0.3 sqrt(m_min / k_max) = ") &&
-                                     Contains("(m_min = " + fmt(sphere::sphere_mass(ps[2].radius, ps[2].density)) +
+                                          " s exceeds the stable bound 0.3 sqrt(m / k_max) = ") &&
+                                     Contains(" s of the contact law linear<elastic_viscous_frictional, "
+                                              "visco_frictional> (smallest at particle 2: m = " +
+                                              fmt(sphere::sphere_mass(ps[2].radius, ps[2].density)) +
                                               " kg, k_max = " + fmt(Real(k_max)) + " N/m)"));
         };
         check_bound(1e5); // k_n

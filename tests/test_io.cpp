@@ -359,6 +359,44 @@ TEMPLATE_TEST_CASE("a writer killed while writing leaves the previous checkpoint
     CHECK_FALSE(fs::exists(tmp));
 }
 
+TEMPLATE_TEST_CASE("format version 4 checkpoints, from before the contact-law interface, still load",
+                   "[io][checkpoint]", float, double)
+{
+    // Version 4 is version 5 without the law's name and history layout at the start of the
+    // payload (docs/io.md): a version 4 file made so from a version 5 one reads back to the
+    // same settings and state, and restarts; a reader with another law's parameters refuses it.
+    using Real = TestType;
+    temp_folder dir;
+    host_sim<Real> sim = eventful_run<Real>(100);
+    const std::string v5 = dir / "v5.ck", v4 = dir / "v4.ck";
+    sphere::write_checkpoint(v5, sim);
+    std::string b = read_bytes(v5);
+    const std::string name = sphere::contact::linear<>::name(), layout = sphere::contact::linear<>::history_layout;
+    const std::size_t law_bytes = 16 + name.size() + layout.size();
+    b.erase(24, law_bytes);
+    b.resize(b.size() - 8);
+    b[8] = 4;
+    const std::uint64_t payload = b.size() - 24;
+    for (int k = 0; k < 8; ++k) b[16 + k] = static_cast<char>((payload >> (8 * k)) & 0xffu);
+    const std::uint64_t sum = sphere::detail::fnv1a64(b.data(), b.size());
+    for (int k = 0; k < 8; ++k) b += static_cast<char>((sum >> (8 * k)) & 0xffu);
+    write_bytes(v4, b);
+
+    const sphere::checkpoint_data<Real> old = sphere::read_checkpoint<Real>(v4), now = sphere::read_checkpoint<Real>(v5);
+    require_identical(old.state, now.state);
+    CHECK(old.config.contact.k_n == now.config.contact.k_n);
+    CHECK(old.config.contact.mu_d == now.config.contact.mu_d);
+    CHECK(old.config.wall.gamma_t == now.config.wall.gamma_t);
+    CHECK(old.config.wall.damping == now.config.wall.damping);
+    host_sim<Real> a = sphere::restart<host_sim<Real>>(v4), c = sphere::restart<host_sim<Real>>(v5);
+    a.run(50);
+    c.run(50);
+    require_identical(a.state(), c.state());
+    CHECK_THROWS_WITH((sphere::read_checkpoint<Real, sphere::contact::hertz_mindlin<>>(v4)),
+                      Catch::Contains("format version 4, but this build reads version 5 only for a contact law other "
+                                      "than the linear one, which version 4 does not describe"));
+}
+
 // ---------------------------------------------------------------------------------------------
 // (c) refused files
 // ---------------------------------------------------------------------------------------------
@@ -396,32 +434,40 @@ TEMPLATE_TEST_CASE("broken checkpoints raise the documented errors", "[io][check
             return d;
         };
         const std::uint64_t n = 64, entries = sim.state().contacts.partner.size();
+        // The payload starts with the contact law's name and history layout (texts: a u64
+        // length, then the bytes), then the settings.
+        const std::string name = sphere::contact::linear<>::name(), layout = sphere::contact::linear<>::history_layout;
+        CHECK(u64_at(24) == name.size());
+        CHECK(bytes.compare(32, name.size(), name) == 0);
+        CHECK(u64_at(32 + name.size()) == layout.size());
+        CHECK(bytes.compare(40 + name.size(), layout.size(), layout) == 0);
+        const std::size_t law_bytes = 16 + name.size() + layout.size(), at = 24 + law_bytes;
         CHECK(bytes.compare(0, 8, "SPHERECK") == 0);
-        CHECK(u32_at(8) == 4);
+        CHECK(u32_at(8) == 5);
         CHECK(u32_at(12) == sizeof(Real));
         CHECK(u64_at(16) == size - 32);
-        CHECK(size == 1036 + 289 * n + 36 * entries);
-        CHECK(f64_at(24 + 40) == double(sim.config().box.hi.z)); // box.hi = payload bytes 24-47
-        CHECK(u32_at(24 + 48) == 0); // box.axis[0]: wall
-        CHECK(f64_at(24 + 60) == double(sim.config().contact.k_n));
-        CHECK(f64_at(24 + 116 + 32) == double(sim.config().wall.mu_s));
-        CHECK(f64_at(24 + 172 + 16) == double(sim.config().gravity.z));
-        CHECK(f64_at(24 + 196) == double(sim.dt()));
-        CHECK(f64_at(24 + 204) == double(sim.config().skin));
-        CHECK(u32_at(24 + 212) == 1); // contact_forces
-        CHECK(u32_at(24 + 216) == 1); // energy_audit
-        CHECK(u32_at(24 + 220) == 1); // angular_position
-        CHECK(u32_at(24 + 232 + 5 * 52) == 2); // walls[5].mode: stress
-        CHECK(f64_at(24 + 232 + 5 * 52 + 4 + 16) == double(sim.config().walls[5].amplitude));
-        CHECK(u64_at(24 + 544) == n);
-        CHECK(u64_at(24 + 552) == 100); // steps
-        CHECK(u64_at(24 + 560) == sim.rebuilds());
-        CHECK(u32_at(24 + 572 + 5 * 36) == 1); // face 5 active
-        CHECK(f64_at(24 + 572 + 5 * 36 + 4) == double(sim.walls().face[5].position));
-        CHECK(f64_at(24 + 788 + 5 * 8) == double(sim.state().walls_at_build.face[5].position));
-        CHECK(f64_at(24 + 836) == sim.drive_work());
-        CHECK(u64_at(24 + 844) == n); // the positions' count
-        CHECK(f64_at(24 + 844 + 8 + 3 * 8) == double(sim.snapshot().x[0].w)); // particle 0's radius
+        CHECK(size == 1036 + law_bytes + 289 * n + 36 * entries);
+        CHECK(f64_at(at + 40) == double(sim.config().box.hi.z)); // box.hi = settings bytes 24-47
+        CHECK(u32_at(at + 48) == 0); // box.axis[0]: wall
+        CHECK(f64_at(at + 60) == double(sim.config().contact.k_n));
+        CHECK(f64_at(at + 116 + 32) == double(sim.config().wall.mu_s));
+        CHECK(f64_at(at + 172 + 16) == double(sim.config().gravity.z));
+        CHECK(f64_at(at + 196) == double(sim.dt()));
+        CHECK(f64_at(at + 204) == double(sim.config().skin));
+        CHECK(u32_at(at + 212) == 1); // contact_forces
+        CHECK(u32_at(at + 216) == 1); // energy_audit
+        CHECK(u32_at(at + 220) == 1); // angular_position
+        CHECK(u32_at(at + 232 + 5 * 52) == 2); // walls[5].mode: stress
+        CHECK(f64_at(at + 232 + 5 * 52 + 4 + 16) == double(sim.config().walls[5].amplitude));
+        CHECK(u64_at(at + 544) == n);
+        CHECK(u64_at(at + 552) == 100); // steps
+        CHECK(u64_at(at + 560) == sim.rebuilds());
+        CHECK(u32_at(at + 572 + 5 * 36) == 1); // face 5 active
+        CHECK(f64_at(at + 572 + 5 * 36 + 4) == double(sim.walls().face[5].position));
+        CHECK(f64_at(at + 788 + 5 * 8) == double(sim.state().walls_at_build.face[5].position));
+        CHECK(f64_at(at + 836) == sim.drive_work());
+        CHECK(u64_at(at + 844) == n); // the positions' count
+        CHECK(f64_at(at + 844 + 8 + 3 * 8) == double(sim.snapshot().x[0].w)); // particle 0's radius
     }
     SECTION("missing")
     {
@@ -476,11 +522,11 @@ TEMPLATE_TEST_CASE("broken checkpoints raise the documented errors", "[io][check
     SECTION("wrong version")
     {
         std::string b = bytes;
-        REQUIRE(b[8] == 4); // the version, little-endian u32 at byte 8
+        REQUIRE(b[8] == 5); // the version, little-endian u32 at byte 8
         b[8] = 3;
         write_bytes(bad, b);
         REQUIRE_THROWS_WITH(sphere::read_checkpoint<Real>(bad),
-                            where + "format version 3, but this build reads version 4 only");
+                            where + "format version 3, but this build reads version 5, and 4 for the linear contact law");
     }
     SECTION("sizes that do not fit the particle count")
     {

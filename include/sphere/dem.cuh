@@ -11,6 +11,8 @@
 #include "contact/contact_lists.cuh"
 #include "contact/energy.cuh"
 #include "contact/interact.cuh"
+#include "contact/law.cuh"
+#include "contact/laws.cuh"
 #include "contact/linear.cuh"
 #include "contact/params.cuh"
 #include "contact/restitution.cuh"

@@ -12,13 +12,16 @@
 
 namespace sphere {
 
-template <class Real>
+/// `Params` is the contact law's parameter type (`Law::params<Real>`, contact/law.cuh); the
+/// default is the linear law's.
+template <class Real, class Params = contact_params<Real>>
 struct settings {
+    using params_type = Params;
     world<Real> box;                ///< world box and per-axis boundaries
-    contact_params<Real> contact;   ///< particle-particle contacts
-    contact_params<Real> wall;      ///< particle-wall contacts (sphere's k_n, gamma_wn, gamma_wt, mu_ws, mu_wd)
+    Params contact;                 ///< particle-particle contacts
+    Params wall;                    ///< particle-wall contacts (linear law: sphere's k_n, gamma_wn, gamma_wt, mu_ws, mu_wd)
     vec3<Real> gravity{0, 0, 0};    ///< (m/s^2)
-    Real dt = 0;                    ///< time step (s); 0 selects 0.075 min sqrt(m / max(k_n, k_t))
+    Real dt = 0;                    ///< time step (s); 0 selects the contact law's rule (linear: 0.075 min sqrt(m / max(k_n, k_t)))
     Real skin = 0;                  ///< contact-list skin (m); 0 rebuilds the lists every step, as sphere
     /// Keep each contact's force of the last step (for the stress and contact-network analyses
     /// of analysis/stress.cuh); off saves 32 B (double) per listed pair and their stores.

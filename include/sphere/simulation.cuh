@@ -203,20 +203,24 @@ template <class Precision, class Policy = host, class Law = contact::linear<>,
 class simulation {
     using Real = real_t<Precision>;  ///< particle fields other than positions, contact laws
     using Coord = coord_t<Precision>; ///< positions, walls, the world, user-facing values
+    using kernel_params = typename Law::template kernel_params<Real>;
 
 public:
     using precision_type = Precision;
     using real_type = Coord;
     using policy_type = Policy;
+    using law_type = Law;
+    using settings_type = settings<Coord, typename Law::template params<Coord>>;
     using observer = std::function<void(const simulation&)>;
 
     /// Validates everything and builds the first contact lists; throws sphere::error on bad input.
-    simulation(const settings<Coord>& s, std::vector<particle<Coord>> particles)
-        : settings_(s), pair_params_(params_cast<Real>(s.contact)), wall_params_(params_cast<Real>(s.wall)),
-          gravity_(vec_cast<Real>(s.gravity))
+    simulation(const settings_type& s, std::vector<particle<Coord>> particles)
+        : settings_(s), gravity_(vec_cast<Real>(s.gravity))
     {
         validate_world(s.box);
         Law::validate(s.contact, s.wall);
+        pair_params_ = Law::template pair_kernel<Real>(s.contact);
+        wall_params_ = Law::template wall_kernel<Real>(s.contact, s.wall);
         if (!isfinite(s.gravity))
             detail::fail("settings.gravity (", s.gravity.x, ", ", s.gravity.y, ", ", s.gravity.z, ") m/s^2 is not finite");
         if (!(s.skin >= 0) || !std::isfinite(s.skin))
@@ -228,30 +232,31 @@ public:
         validate_particles(particles, s.box);
         check_fits_real(s);
 
-        Coord min_mass = 0, max_radius = 0;
+        Coord max_radius = 0;
         for (std::size_t i = 0; i < particles.size(); ++i) {
             particle<Coord>& p = particles[i];
             for (int a = 0; a < 3; ++a) p.position[a] = s.box.wrap(p.position[a], a);
-            const Coord m = sphere_mass(p.radius, p.density);
             if constexpr (!std::is_same_v<Real, Coord>) {
-                fits_real(m, " kg", "particle ", i, ": mass (radius ", p.radius, " m, density ", p.density, " kg/m^3)");
+                fits_real(sphere_mass(p.radius, p.density), " kg", "particle ", i, ": mass (radius ", p.radius, " m, density ", p.density, " kg/m^3)");
                 for (int a = 0; a < 3; ++a) {
                     fits_real(p.velocity[a], " m/s", "particle ", i, ": velocity[", a, "]");
                     fits_real(p.angular_velocity[a], " rad/s", "particle ", i, ": angular_velocity[", a, "]");
                 }
             }
-            min_mass = i == 0 || m < min_mass ? m : min_mass;
             max_radius = p.radius > max_radius ? p.radius : max_radius;
         }
         largest_radius_ = max_radius;
-        const Coord bound = stable_time_step_bound(min_mass, s.contact, s.wall);
+        const time_scale_minimum<Coord> scale = smallest_time_scale<Law>(s.contact, s.wall, particles);
+        const Coord bound = Coord(Law::time_step.bound_factor) * scale.scale;
         if (s.dt == Coord(0)) {
-            dt_ = default_time_step(min_mass, s.contact, s.wall);
+            dt_ = Coord(Law::time_step.default_factor) * scale.scale;
         } else if (!(s.dt > 0) || !std::isfinite(s.dt)) {
             detail::fail("settings.dt = ", s.dt, " s: must be positive and finite (0 = automatic)");
         } else if (s.dt > bound) {
-            detail::fail("settings.dt = ", s.dt, " s exceeds the stable bound 0.3 sqrt(m_min / k_max) = ", bound,
-                         " s (m_min = ", min_mass, " kg, k_max = ", stiffest(s.contact, s.wall), " N/m)");
+            const particle<Coord>& p = particles[scale.particle];
+            detail::fail("settings.dt = ", s.dt, " s exceeds the stable bound ", Law::time_step.bound_formula(), " = ", bound, " s of the contact law ", Law::name(), " (smallest at particle ",
+                         scale.particle, ": ",
+                         Law::time_scale_inputs(s.contact, s.wall, sphere_mass(p.radius, p.density), p.radius), ")");
         } else {
             dt_ = s.dt;
         }
@@ -379,7 +384,7 @@ public:
     std::size_t steps() const { return steps_; }
     /// How many times the grid and contact lists were built (including at setup).
     std::size_t rebuilds() const { return rebuilds_; }
-    const settings<Coord>& config() const { return settings_; }
+    const settings_type& config() const { return settings_; }
     const wall_set<Coord>& walls() const { return walls_; }
     /// Work done on the particles by whatever drives the prescribed ones, so far (J); part of
     /// energy().boundary_work, with the work of the walls.
@@ -834,17 +839,15 @@ private:
     }
 
     /// fits_real for every contact parameter and gravity (precision mixed).
-    static void check_fits_real(const settings<Coord>& s)
+    static void check_fits_real(const settings_type& s)
     {
         if constexpr (!std::is_same_v<Real, Coord>) {
-            for (const auto& [p, where] : {std::pair{&s.contact, "settings.contact"}, std::pair{&s.wall, "settings.wall"}}) {
-                fits_real(p->k_n, " N/m", where, ".k_n");
-                fits_real(p->k_t, " N/m", where, ".k_t");
-                fits_real(p->gamma_n, "", where, ".gamma_n");
-                fits_real(p->gamma_t, "", where, ".gamma_t");
-                fits_real(p->mu_s, "", where, ".mu_s");
-                fits_real(p->mu_d, "", where, ".mu_d");
-            }
+            using params = typename Law::template params<Coord>;
+            for (const auto& given : {std::pair{&s.contact, "settings.contact"}, std::pair{&s.wall, "settings.wall"}})
+                params::fields(*given.first, [&, where = given.second](const char* name, const auto& value, const char* unit) {
+                    if constexpr (std::is_floating_point_v<std::decay_t<decltype(value)>>)
+                        fits_real(value, (*unit ? std::string(" ") + unit : std::string()).c_str(), where, ".", name);
+                });
             for (int a = 0; a < 3; ++a) fits_real(s.gravity[a], " m/s^2", "settings.gravity[", a, "]");
         }
     }
@@ -865,8 +868,8 @@ private:
                      walls_.face[5].position, "] m");
     }
 
-    settings<Coord> settings_;
-    contact_params<Real> pair_params_, wall_params_; ///< settings_.contact and .wall in the laws' precision
+    settings_type settings_;
+    kernel_params pair_params_, wall_params_; ///< what the law's kernels receive for settings_.contact and .wall
     vec3<Real> gravity_;                             ///< settings_.gravity in the particles' precision
     Coord dt_ = 0;
     Coord largest_radius_ = 0; ///< largest_radius()

@@ -9,7 +9,7 @@
 #include "../particles/state.cuh"
 #include "contact_lists.cuh"
 #include "evaluate.cuh"
-#include "params.cuh"
+#include "result.cuh"
 
 namespace sphere {
 
@@ -59,8 +59,8 @@ struct particle_energy {
     contact_view<Real> c;
     world<Coord> box;
     wall_set<Coord> walls;
-    contact_params<Real> pair_params;
-    contact_params<Real> wall_params;
+    typename Law::template kernel_params<Real> pair_params;
+    typename Law::template kernel_params<Real> wall_params;
     vec3<Coord> gravity;
 
     SPHERE_HD energy_budget<Coord> operator()(std::size_t i) const
@@ -79,15 +79,26 @@ struct particle_energy {
                 const vec3<Coord> d = box.nearest_image_inside(xi.xyz() - xj.xyz());
                 const Coord dist2 = norm2(d), reach = xi.w + xj.w;
                 if (!(dist2 < reach * reach)) continue;
-                vec3<Real> n;
-                const Real delta_n = overlap_and_normal(d, dist2, reach, n);
-                if (delta_n < Real(0)) e.elastic += Coord(Law::pair_energy(pair_params, delta_n, c.history.load(k)));
+                contact_geometry<Real> g;
+                g.delta_n = overlap_and_normal(d, dist2, reach, g.n);
+                g.r_i = Real(xi.w);
+                g.r_j = Real(xj.w);
+                g.r_eff = g.r_i * g.r_j / (g.r_i + g.r_j);
+                g.m_i = p.mass[i];
+                g.m_j = p.mass[j];
+                g.m_eff = g.m_i * g.m_j / (g.m_i + g.m_j);
+                if (g.delta_n < Real(0)) e.elastic += Coord(Law::pair_energy(pair_params, g, c.history.load(k)));
             } else {
                 const int f = static_cast<int>(j - wall_partner_base);
                 const int a = f / 2;
-                const Real delta_n = Real((xi.xyz()[a] - Coord(walls.face[f].position)) *
-                                              Coord(wall_set<Real>::inward_normal(f)[a]) - xi.w);
-                if (delta_n < Real(0)) e.elastic += Coord(Law::wall_energy(wall_params, delta_n, c.history.load(k)));
+                contact_geometry<Real> g;
+                g.n = wall_set<Real>::inward_normal(f);
+                g.delta_n = Real((xi.xyz()[a] - Coord(walls.face[f].position)) * Coord(g.n[a]) - xi.w);
+                g.r_i = g.r_eff = Real(xi.w);
+                g.r_j = Real(0);
+                g.m_i = g.m_eff = p.mass[i];
+                g.m_j = Real(0);
+                if (g.delta_n < Real(0)) e.elastic += Coord(Law::wall_energy(wall_params, g, c.history.load(k)));
             }
         }
         if (p.e_visc) { // the energy audit is on

@@ -24,7 +24,6 @@
 #include "../core/constants.cuh"
 #include "../particles/state.cuh"
 #include "contact_lists.cuh"
-#include "params.cuh"
 #include "result.cuh"
 
 namespace sphere {
@@ -80,7 +79,7 @@ struct pair_contact {
     using Coord = coord_t<P>;
     particle_view<P> p;
     world<Coord> box;
-    contact_params<Real> params;
+    typename Law::template kernel_params<Real> params;
     Real dt;
 
     /// The contact of i (owner) and j (slots) with history h (updated): both particles'
@@ -109,6 +108,11 @@ struct pair_contact {
         contact_motion<Real> m;
         m.n = n;
         m.delta_n = delta_n;
+        m.r_i = Real(xi.w);
+        m.r_j = Real(xj.w);
+        m.r_eff = m.r_i * m.r_j / (m.r_i + m.r_j);
+        m.m_i = mi;
+        m.m_j = mj;
         m.velocity = p.v_sync[i] - p.v_sync[j] + arm_i * cross(n, p.omega_sync[i]) + arm_j * cross(n, p.omega_sync[j]);
         m.step = OneVelocity ? m.velocity * dt
                              : (p.v[i] - p.v[j]) * dt + arm_i * cross(n, p.omega[i] * dt) +
@@ -154,7 +158,7 @@ struct wall_contacts {
     contact_view<Real> c;
     const unsigned* ranks; ///< contact_lists::wall_ranks
     wall_set<Coord> walls;
-    contact_params<Real> params;
+    typename Law::template kernel_params<Real> params;
     Real dt;
     bool update_history; ///< false for a force evaluation that must leave the contacts as they are
 
@@ -188,7 +192,15 @@ struct wall_contacts {
             const Real dist = Real(dist_c), delta_n = Real(dist_c - xi.w);
             vec4<Real> h = c.history.load(k);
             if (delta_n < Real(0)) {
-                contact_motion<Real> m{n, delta_n, vi + dist * cross(n, wi), si + dist * cross(n, ti), p.mass[i]};
+                contact_motion<Real> m;
+                m.n = n;
+                m.delta_n = delta_n;
+                m.r_i = m.r_eff = Real(xi.w);
+                m.r_j = Real(0);
+                m.m_i = m.m_eff = p.mass[i];
+                m.m_j = Real(0);
+                m.velocity = vi + dist * cross(n, wi);
+                m.step = si + dist * cross(n, ti);
                 m.velocity -= along_axis(a, Real(wall_velocity)); // 0 subtracted on the other axes
                 if (OneVelocity) m.step = m.velocity * dt;
                 else m.step -= along_axis(a, Real(wall_velocity) * dt);

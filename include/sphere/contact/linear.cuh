@@ -4,9 +4,11 @@
 /// and a swappable tangential law, one for particle pairs and one for walls.
 /// Equations and units: docs/physics.md, "Normal force" and "Tangential force".
 #include <cmath>
+#include <string>
 
 #include "../core/error.cuh"
 #include "../core/vec.cuh"
+#include "law.cuh"
 #include "params.cuh"
 #include "result.cuh"
 #include "tangential.cuh"
@@ -39,14 +41,29 @@ SPHERE_HDI normal_force<Real> linear_normal(const contact_params<Real>& p, Real 
     return {clipped ? Real(0) : trial, visc};
 }
 
-/// The linear contact law. `PairTangential` and `WallTangential` are tangential policies
-/// (tangential::elastic_viscous_frictional or tangential::visco_frictional); the defaults
-/// follow sphere: elastic tangential springs between particles, viscous friction at walls.
+/// The linear contact law (the interface of contact/law.cuh). `PairTangential` and
+/// `WallTangential` are tangential policies (tangential::elastic_viscous_frictional or
+/// tangential::visco_frictional); the defaults follow sphere: elastic tangential springs
+/// between particles, viscous friction at walls.
 template <class PairTangential = tangential::elastic_viscous_frictional,
           class WallTangential = tangential::visco_frictional>
 struct linear {
     using pair_tangential = PairTangential;
     using wall_tangential = WallTangential;
+    template <class Real>
+    using params = contact_params<Real>;
+    template <class Real>
+    using kernel_params = contact_params<Real>;
+
+    static std::string name()
+    {
+        return std::string("linear<") + PairTangential::name + ", " + WallTangential::name + ">";
+    }
+    static constexpr const char* history_layout = "tangential displacement (m) xyz, sliding flag w";
+
+    /// sphere's rule: dt = 0.075 sqrt(m_min / k_max), about 40 steps per pair contact; at most
+    /// 0.3 sqrt(m_min / k_max), about 10 steps (docs/physics.md, "Time step").
+    static constexpr time_step_rule time_step{0.075, 0.3, "sqrt(m / k_max)"};
 
     /// Throws sphere::error naming the first bad parameter.
     template <class Real>
@@ -56,6 +73,30 @@ struct linear {
         check(wall, "settings.wall");
         PairTangential::validate(pair, "settings.contact");
         WallTangential::validate(wall, "settings.wall");
+    }
+
+    template <class Real, class From>
+    static contact_params<Real> pair_kernel(const contact_params<From>& pair)
+    {
+        return params_cast<Real>(pair);
+    }
+    template <class Real, class From>
+    static contact_params<Real> wall_kernel(const contact_params<From>&, const contact_params<From>& wall)
+    {
+        return params_cast<Real>(wall);
+    }
+
+    /// sqrt(m / k_max) (s), k_max the largest of k_n and k_t of pairs and walls.
+    template <class Real>
+    static Real time_scale(const contact_params<Real>& pair, const contact_params<Real>& wall, Real mass, Real)
+    {
+        return std::sqrt(mass / stiffest(pair, wall));
+    }
+    template <class Real>
+    static std::string time_scale_inputs(const contact_params<Real>& pair, const contact_params<Real>& wall, Real mass,
+                                         Real)
+    {
+        return detail::text("m = ", mass, " kg, k_max = ", stiffest(pair, wall), " N/m");
     }
 
     /// Evaluates a pair contact with motion m, history entry h and time step dt (s).
@@ -76,16 +117,18 @@ struct linear {
 
     /// Elastic energy stored in a pair contact: k_n delta_n^2 / 2 plus the tangential spring (J).
     template <class Real>
-    SPHERE_HDI static Real pair_energy(const contact_params<Real>& p, Real delta_n, const vec4<Real>& h)
+    SPHERE_HDI static Real pair_energy(const contact_params<Real>& p, const contact_geometry<Real>& g,
+                                      const vec4<Real>& h)
     {
-        return Real(0.5) * p.k_n * delta_n * delta_n + PairTangential::stored_energy(p, h);
+        return Real(0.5) * p.k_n * g.delta_n * g.delta_n + PairTangential::stored_energy(p, h);
     }
 
     /// Elastic energy stored in a wall contact (J).
     template <class Real>
-    SPHERE_HDI static Real wall_energy(const contact_params<Real>& p, Real delta_n, const vec4<Real>& h)
+    SPHERE_HDI static Real wall_energy(const contact_params<Real>& p, const contact_geometry<Real>& g,
+                                      const vec4<Real>& h)
     {
-        return Real(0.5) * p.k_n * delta_n * delta_n + WallTangential::stored_energy(p, h);
+        return Real(0.5) * p.k_n * g.delta_n * g.delta_n + WallTangential::stored_energy(p, h);
     }
 
 private:
@@ -117,6 +160,13 @@ private:
         out.visc_rate = fn.visc_rate + ft.visc_rate;
         out.fric_rate = ft.fric_rate;
         return out;
+    }
+
+    template <class Real>
+    static Real stiffest(const contact_params<Real>& pair, const contact_params<Real>& wall)
+    {
+        using std::fmax;
+        return fmax(fmax(pair.k_n, pair.k_t), fmax(wall.k_n, wall.k_t));
     }
 
     template <class Real>

@@ -26,7 +26,25 @@ struct contact_params {
     Real mu_d = 0;     ///< dynamic friction coefficient, 0 <= mu_d <= mu_s
     bool tension = false; ///< allow an attractive normal force (false: clipped at 0, as sphere does)
     damping_convention damping = damping_convention::absolute; ///< units of gamma_n and gamma_t
+
+    /// Calls f(name, field, unit) for every field, in the order of checkpoints (io/checkpoint.cuh)
+    /// and of the precision checks; Self is contact_params or const contact_params.
+    template <class Self, class F>
+    static void fields(Self& p, F&& f)
+    {
+        f("k_n", p.k_n, "N/m");
+        f("k_t", p.k_t, "N/m");
+        f("gamma_n", p.gamma_n, "");
+        f("gamma_t", p.gamma_t, "");
+        f("mu_s", p.mu_s, "");
+        f("mu_d", p.mu_d, "");
+        f("tension", p.tension, "");
+        f("damping", p.damping, "");
+    }
 };
+
+/// The largest valid value of the enumeration (checkpoints refuse larger ones).
+constexpr unsigned largest_value(damping_convention) { return 2; }
 
 /// The same parameters in another precision (the user's double values for a contact law that
 /// computes in float, precision mixed).

@@ -5,16 +5,25 @@
 
 namespace sphere {
 
+/// The geometry of one contact, as seen by the particle i it acts on. At a wall the partner j
+/// is the wall: r_j = m_j = 0 stand for its infinite radius and mass (r_eff = r_i, m_eff = m_i).
+template <class Real>
+struct contact_geometry {
+    vec3<Real> n;  ///< unit normal, from the partner (particle or wall) towards this particle
+    Real delta_n;  ///< overlap (m), negative while in contact
+    Real r_i, r_j; ///< radii (m)
+    Real r_eff;    ///< effective radius (m): r_i r_j / (r_i + r_j) for a pair, r_i at a wall
+    Real m_i, m_j; ///< masses (kg)
+    Real m_eff;    ///< effective mass (kg): m_i m_j / (m_i + m_j) for a pair, m_i at a wall
+};
+
 /// The geometry and relative motion of one contact, as seen by the particle it acts on.
 template <class Real>
-struct contact_motion {
-    vec3<Real> n;        ///< unit normal, from the partner (particle or wall) towards this particle
-    Real delta_n;        ///< overlap (m), negative while in contact
+struct contact_motion : contact_geometry<Real> {
     vec3<Real> velocity; ///< velocity of this particle's contact point relative to the partner's,
                          ///< at the time of the positions (m/s): drives the dashpots
     vec3<Real> step;     ///< displacement of the contact point relative to the partner's during
                          ///< the step that led to the positions (m): drives the tangential spring
-    Real m_eff;          ///< effective mass (kg): m_i m_j / (m_i + m_j) for a pair, m_i at a wall
 };
 
 /// One evaluated contact, as seen by the particle it acts on.

@@ -26,6 +26,8 @@ namespace tangential {
 /// f_t = -gamma_t v_t, limited to mu |f_n| (static limit mu_s while sticking, mu_d while
 /// sliding). Keeps no displacement; only the sliding flag h.w.
 struct visco_frictional {
+    static constexpr const char* name = "visco_frictional";
+
     template <class Real>
     static void validate(const contact_params<Real>&, const char*) {}
 
@@ -65,6 +67,8 @@ struct visco_frictional {
 /// motion less the change of the spring's energy, so the energy budget closes whatever
 /// gamma_t is.
 struct elastic_viscous_frictional {
+    static constexpr const char* name = "elastic_viscous_frictional";
+
     template <class Real>
     static void validate(const contact_params<Real>& p, const char* where)
     {

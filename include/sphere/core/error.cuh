@@ -16,14 +16,21 @@ public:
 };
 
 namespace detail {
-/// Builds a message from streamable parts: `fail("radius ", r, " of particle ", i)`.
+/// Streamable parts as one text, numbers with 17 significant digits.
 template <class... Parts>
-[[noreturn]] void fail(const Parts&... parts)
+std::string text(const Parts&... parts)
 {
     std::ostringstream out;
     out.precision(17);
     (out << ... << parts);
-    throw error(out.str());
+    return out.str();
+}
+
+/// Builds a message from streamable parts: `fail("radius ", r, " of particle ", i)`.
+template <class... Parts>
+[[noreturn]] void fail(const Parts&... parts)
+{
+    throw error(text(parts...));
 }
 } // namespace detail
 } // namespace sphere

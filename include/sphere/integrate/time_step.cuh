@@ -1,41 +1,35 @@
 #pragma once
 /// \file
-/// The time-step rule and the stable bound (docs/physics.md, "Time step").
-#include <cmath>
+/// The time step of a contact law's rule (contact/law.cuh, time_step_rule; docs/physics.md,
+/// "Time step"), from the particles.
+#include <cstddef>
+#include <vector>
 
-#include "../contact/params.cuh"
+#include "../core/constants.cuh"
+#include "../particles/particle.cuh"
 
 namespace sphere {
 
-/// Factor of sphere's rule dt = 0.075 sqrt(m_min / k_max): about 40 steps per pair contact.
-template <class Real> inline constexpr Real time_step_factor = Real(0.075);
-
-/// Factor of the largest time step the library accepts, dt <= 0.3 sqrt(m_min / k_max): about
-/// 10 steps per pair contact. The symplectic integrator is stable for omega dt < 2; a particle
-/// pressed by 12 neighbours of its own mass has omega = sqrt(12 k / m), so it stays stable up
-/// to dt = 0.58 sqrt(m / k); 0.3 leaves room for damping and for lighter neighbours.
-template <class Real> inline constexpr Real time_step_bound_factor = Real(0.3);
-
-/// The largest stiffness in use (N/m).
+/// The smallest of a law's time scale over the particles (s) and the particle (user index)
+/// that has it.
 template <class Real>
-Real stiffest(const contact_params<Real>& pair, const contact_params<Real>& wall)
-{
-    using std::fmax;
-    return fmax(fmax(pair.k_n, pair.k_t), fmax(wall.k_n, wall.k_t));
-}
+struct time_scale_minimum {
+    Real scale = 0;
+    std::size_t particle = 0;
+};
 
-/// sphere's time step 0.075 sqrt(m_min / max(k_n, k_t)) (s).
-template <class Real>
-Real default_time_step(Real min_mass, const contact_params<Real>& pair, const contact_params<Real>& wall)
+/// Law's time scale minimised over `particles` (masses from radius and density).
+template <class Law, class Real, class Params>
+time_scale_minimum<Real> smallest_time_scale(const Params& pair, const Params& wall,
+                                             const std::vector<particle<Real>>& particles)
 {
-    return time_step_factor<Real> * std::sqrt(min_mass / stiffest(pair, wall));
-}
-
-/// The largest accepted time step, 0.3 sqrt(m_min / max(k_n, k_t)) (s).
-template <class Real>
-Real stable_time_step_bound(Real min_mass, const contact_params<Real>& pair, const contact_params<Real>& wall)
-{
-    return time_step_bound_factor<Real> * std::sqrt(min_mass / stiffest(pair, wall));
+    time_scale_minimum<Real> out;
+    for (std::size_t i = 0; i < particles.size(); ++i) {
+        const Real t = Law::time_scale(pair, wall, sphere_mass(particles[i].radius, particles[i].density),
+                                       particles[i].radius);
+        if (i == 0 || t < out.scale) out = {t, i};
+    }
+    return out;
 }
 
 } // namespace sphere

@@ -25,6 +25,7 @@
 #include <limits>
 #include <sstream>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "../boundary/wall_control.cuh"
@@ -42,16 +43,18 @@
 
 namespace sphere {
 
-/// The checkpoint format version this build writes, and the only one it reads.
-inline constexpr std::uint32_t checkpoint_format_version = 4;
+/// The checkpoint format version this build writes. It also reads version 4, which predates
+/// the contact-law interface and holds the linear law's parameters without the law's name.
+inline constexpr std::uint32_t checkpoint_format_version = 5;
 
 /// The first 8 bytes of every checkpoint.
 inline constexpr char checkpoint_magic[9] = "SPHERECK";
 
-/// The contents of a checkpoint, in the reader's precision.
-template <class Real>
+/// The contents of a checkpoint, in the reader's precision, for a simulation with the contact
+/// law `Law`.
+template <class Real, class Law = contact::linear<>>
 struct checkpoint_data {
-    settings<Real> config;             ///< the settings; config.dt is the time step the run used (s)
+    settings<Real, typename Law::template params<Real>> config; ///< the settings; config.dt is the time step the run used (s)
     simulation_state<Real> state;      ///< every evolving field
     std::uint32_t written_precision = 0; ///< sizeof the writer's Real: 4 (float) or 8 (double)
 
@@ -132,17 +135,23 @@ public:
         f64(double(a.z));
         f64(double(a.w));
     }
-    template <class Real>
-    void params(const contact_params<Real>& p)
+    /// A contact law's parameters, field by field (Params::fields): floating values as f64,
+    /// flags and enumerations as u32.
+    template <class Params>
+    void params(const Params& p)
     {
-        f64(double(p.k_n));
-        f64(double(p.k_t));
-        f64(double(p.gamma_n));
-        f64(double(p.gamma_t));
-        f64(double(p.mu_s));
-        f64(double(p.mu_d));
-        u32(p.tension ? 1u : 0u);
-        u32(static_cast<std::uint32_t>(p.damping));
+        Params::fields(p, [&](const char*, const auto& v, const char*) {
+            using T = std::decay_t<decltype(v)>;
+            if constexpr (std::is_floating_point_v<T>) f64(double(v));
+            else if constexpr (std::is_same_v<T, bool>) u32(v ? 1u : 0u);
+            else u32(static_cast<std::uint32_t>(v));
+        });
+    }
+    /// A text: its length (u64), then its bytes.
+    void text(const std::string& t)
+    {
+        u64(t.size());
+        bytes += t;
     }
     /// An array: its element count (u64), then each element through `put`.
     template <class T, class Put>
@@ -215,19 +224,29 @@ public:
         const double x = f64(what), y = f64(what), z = f64(what), w = f64(what);
         return {Real(x), Real(y), Real(z), Real(w)};
     }
-    template <class Real>
-    contact_params<Real> params(const char* what)
+    /// A contact law's parameters (checkpoint_encoder::params); `what` names them.
+    template <class Params>
+    Params params(const char* what)
     {
-        contact_params<Real> p;
-        p.k_n = Real(f64(what));
-        p.k_t = Real(f64(what));
-        p.gamma_n = Real(f64(what));
-        p.gamma_t = Real(f64(what));
-        p.mu_s = Real(f64(what));
-        p.mu_d = Real(f64(what));
-        p.tension = choice(what, 1) == 1;
-        p.damping = static_cast<damping_convention>(choice(what, 2));
+        Params p;
+        Params::fields(p, [&](const char* name, auto& v, const char*) {
+            using T = std::decay_t<decltype(v)>;
+            const std::string field = std::string(what) + "." + name;
+            if constexpr (std::is_floating_point_v<T>) v = T(f64(field.c_str()));
+            else if constexpr (std::is_same_v<T, bool>) v = choice(field.c_str(), 1) == 1;
+            else v = static_cast<T>(choice(field.c_str(), largest_value(T{})));
+        });
         return p;
+    }
+    /// A text of at most `max` bytes (checkpoint_encoder::text).
+    std::string text(const char* what, std::uint64_t max)
+    {
+        const std::uint64_t size = u64(what);
+        if (size > max) inconsistent(what, " is ", size, " bytes long, at most ", max, " are valid");
+        need(static_cast<std::size_t>(size), what);
+        std::string t = bytes_.substr(at_, static_cast<std::size_t>(size));
+        at_ += static_cast<std::size_t>(size);
+        return t;
     }
     /// An array of `expected` elements of `element_bytes` bytes each, read by `get`.
     template <class T, class Get>
@@ -258,10 +277,12 @@ private:
 
 } // namespace detail
 
-/// The bytes of a checkpoint (the layout of docs/io.md) for settings `config`, the time step
-/// `dt` (s) the run uses (stored in place of config.dt) and a state.
-template <class Real>
-std::string encode_checkpoint(const settings<Real>& config, Real dt, const simulation_state<Real>& s)
+/// The bytes of a checkpoint (the layout of docs/io.md) for a simulation with the contact law
+/// `Law`, its settings `config`, the time step `dt` (s) the run uses (stored in place of
+/// config.dt) and a state.
+template <class Law = contact::linear<>, class Real>
+std::string encode_checkpoint(const settings<Real, typename Law::template params<Real>>& config, Real dt,
+                              const simulation_state<Real>& s)
 {
     using detail::checkpoint_encoder;
     const std::size_t n = s.particles.size();
@@ -273,7 +294,9 @@ std::string encode_checkpoint(const settings<Real>& config, Real dt, const simul
     e.u32(static_cast<std::uint32_t>(sizeof(Real)));
     e.u64(0); // payload size, patched below
 
-    // Settings.
+    // The contact law, then the settings.
+    e.text(Law::name());
+    e.text(Law::history_layout);
     e.v3(config.box.lo);
     e.v3(config.box.hi);
     for (int a = 0; a < 3; ++a) e.u32(static_cast<std::uint32_t>(config.box.axis[a]));
@@ -339,8 +362,8 @@ std::string encode_checkpoint(const settings<Real>& config, Real dt, const simul
 /// errors. Throws sphere::error (message `checkpoint '<path>': ...`, see docs/io.md) when the
 /// bytes are not a checkpoint, have another format version, are truncated or longer than the
 /// header says, fail the checksum, or hold contents that do not fit together.
-template <class Real>
-checkpoint_data<Real> decode_checkpoint(const std::string& bytes, const std::string& path)
+template <class Real, class Law = contact::linear<>>
+checkpoint_data<Real, Law> decode_checkpoint(const std::string& bytes, const std::string& path)
 {
     using detail::checkpoint_decoder;
     constexpr std::size_t header = detail::checkpoint_header_bytes, tail = detail::checkpoint_checksum_bytes;
@@ -354,9 +377,13 @@ checkpoint_data<Real> decode_checkpoint(const std::string& bytes, const std::str
                      header + tail, " of a header and checksum");
     checkpoint_decoder head(bytes, 8, header, path);
     const std::uint32_t version = head.u32("the format version");
-    if (version != checkpoint_format_version)
+    using params = typename Law::template params<Real>;
+    constexpr bool linear_params = std::is_same_v<params, contact_params<Real>>;
+    if (version != checkpoint_format_version && !(version == 4 && linear_params))
         detail::fail("checkpoint '", path, "': format version ", version, ", but this build reads version ",
-                     checkpoint_format_version, " only");
+                     checkpoint_format_version, version == 4 ? " only for a contact law other than the linear one, "
+                                                               "which version 4 does not describe"
+                                                             : ", and 4 for the linear contact law");
     const std::uint32_t precision = head.u32("the writer's precision");
     const std::uint64_t payload = head.u64("the payload size");
     if (payload > std::numeric_limits<std::uint64_t>::max() - header - tail)
@@ -382,14 +409,22 @@ checkpoint_data<Real> decode_checkpoint(const std::string& bytes, const std::str
     if (precision != 4 && precision != 8)
         d.inconsistent("the writer's precision is ", precision, " bytes, neither 4 (float) nor 8 (double)");
 
-    checkpoint_data<Real> c;
+    checkpoint_data<Real, Law> c;
     c.written_precision = precision;
-    settings<Real>& s = c.config;
+    if (version >= 5) {
+        const std::string law = d.text("the contact law's name", 4096);
+        const std::string history = d.text("the contact history's layout", 4096);
+        if (law != Law::name() || history != Law::history_layout)
+            detail::fail("checkpoint '", path, "': written with the contact law ", law, " (history: ", history,
+                         "), but the reader uses ", Law::name(), " (history: ", Law::history_layout,
+                         "); restart it with the same law");
+    }
+    settings<Real, params>& s = c.config;
     s.box.lo = d.v3<Real>("settings.box.lo");
     s.box.hi = d.v3<Real>("settings.box.hi");
     for (int a = 0; a < 3; ++a) s.box.axis[a] = static_cast<boundary>(d.choice("settings.box.axis", 1));
-    s.contact = d.params<Real>("settings.contact");
-    s.wall = d.params<Real>("settings.wall");
+    s.contact = d.params<params>("settings.contact");
+    s.wall = d.params<params>("settings.wall");
     s.gravity = d.v3<Real>("settings.gravity");
     s.dt = Real(d.f64("the time step"));
     s.skin = Real(d.f64("settings.skin"));
@@ -480,10 +515,11 @@ checkpoint_data<Real> decode_checkpoint(const std::string& bytes, const std::str
 
 /// Writes a checkpoint of settings `config`, time step `dt` (s) and a state to `path`
 /// atomically; throws sphere::error naming the file when it cannot be written.
-template <class Real>
-void write_checkpoint(const std::string& path, const settings<Real>& config, Real dt, const simulation_state<Real>& state)
+template <class Law = contact::linear<>, class Real>
+void write_checkpoint(const std::string& path, const settings<Real, typename Law::template params<Real>>& config, Real dt,
+                      const simulation_state<Real>& state)
 {
-    write_file_atomically(path, encode_checkpoint(config, dt, state));
+    write_file_atomically(path, encode_checkpoint<Law>(config, dt, state));
 }
 
 /// Writes a checkpoint of a simulation (its settings, time step and state) to `path`
@@ -491,14 +527,14 @@ void write_checkpoint(const std::string& path, const settings<Real>& config, Rea
 template <class Sim>
 void write_checkpoint(const std::string& path, const Sim& sim)
 {
-    write_checkpoint(path, sim.config(), sim.dt(), sim.state());
+    write_checkpoint<typename Sim::law_type>(path, sim.config(), sim.dt(), sim.state());
 }
 
 /// Reads a checkpoint into the precision Real (values converted when the writer used the
 /// other one). Throws sphere::error `checkpoint '<path>': ...` when the file cannot be opened or
 /// read, or for any of the reasons of decode_checkpoint.
-template <class Real>
-checkpoint_data<Real> read_checkpoint(const std::string& path)
+template <class Real, class Law = contact::linear<>>
+checkpoint_data<Real, Law> read_checkpoint(const std::string& path)
 {
     std::ifstream in(path, std::ios::binary);
     if (!in) {
@@ -507,7 +543,7 @@ checkpoint_data<Real> read_checkpoint(const std::string& path)
     }
     std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     if (in.bad()) detail::fail("checkpoint '", path, "': cannot read the file");
-    return decode_checkpoint<Real>(bytes, path);
+    return decode_checkpoint<Real, Law>(bytes, path);
 }
 
 /// A simulation of type Sim (e.g. sphere::simulation<float>) continuing from the checkpoint
@@ -518,7 +554,7 @@ template <class Sim>
 Sim restart(const std::string& path)
 {
     using Real = typename Sim::real_type;
-    const checkpoint_data<Real> c = read_checkpoint<Real>(path);
+    const checkpoint_data<Real, typename Sim::law_type> c = read_checkpoint<Real, typename Sim::law_type>(path);
     Sim sim(c.config, c.particles());
     sim.restore(c.state);
     return sim;

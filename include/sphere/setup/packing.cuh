@@ -240,8 +240,8 @@ std::vector<particle<Real>> make_particles(const std::vector<vec3<Real>>& centre
 /// Sets s.cell_size = 0 (automatic) and returns the grid the simulation will lay over the box.
 /// Throws for no particles, a negative or non-finite margin or headroom, or a grid that does
 /// not fit (grid_geometry::make).
-template <class Real>
-grid_geometry<Real> fit_world(settings<Real>& s, const std::vector<particle<Real>>& particles, Real margin = 2,
+template <class Real, class Params>
+grid_geometry<Real> fit_world(settings<Real, Params>& s, const std::vector<particle<Real>>& particles, Real margin = 2,
                               Real headroom = 0)
 {
     if (particles.empty()) detail::fail("fit_world: no particles to fit the world to");

@@ -1,0 +1,57 @@
+#pragma once
+/// \file
+/// What a contact law declares, and the time-step rule built on it.
+///
+/// A contact law is a type `Law` with (contact/linear.cuh and contact/hertz_mindlin.cuh are
+/// the examples; docs/architecture.md, "Contact laws"):
+///
+///     template <class Real> using params = ...;         // the user's parameters, in settings
+///                                                      // (.contact for pairs, .wall for walls)
+///     template <class Real> using kernel_params = ...;  // what the kernels receive, derived once
+///     static std::string name();                        // stored in checkpoints
+///     static constexpr const char* history_layout;      // what a contact's history holds
+///     static constexpr time_step_rule time_step;        // factors of the time scale
+///     template <class Real> static void validate(const params<Real>& pair, const params<Real>& wall);
+///     template <class Real, class From> static kernel_params<Real> pair_kernel(const params<From>& pair);
+///     template <class Real, class From>
+///     static kernel_params<Real> wall_kernel(const params<From>& pair, const params<From>& wall);
+///     template <class Real>   // the contact time scale of one particle (s): dt is a fraction of the smallest
+///     static Real time_scale(const params<Real>& pair, const params<Real>& wall, Real mass, Real radius);
+///     template <class Real>   // what time_scale used, for an error message
+///     static std::string time_scale_inputs(const params<Real>& pair, const params<Real>& wall, Real mass, Real radius);
+///     template <class Real>   // a pair contact (a wall contact): forces and dissipation rates
+///     SPHERE_HDI static contact_result<Real> pair(const kernel_params<Real>&, const contact_motion<Real>&,
+///                                                vec4<Real>& history, Real dt);        // and wall(...)
+///     template <class Real>   // the elastic energy stored in a contact (J)
+///     SPHERE_HDI static Real pair_energy(const kernel_params<Real>&, const contact_geometry<Real>&,
+///                                       const vec4<Real>& history);                   // and wall_energy(...)
+///
+/// Each params type P has `template <class Self, class F> static void fields(Self&, F&&)`,
+/// calling f(name, field, unit) for every field (a floating value, a bool or an enumeration
+/// with largest_value()), which checkpoints and the precision checks use.
+///
+/// The history of a contact is, for every law so far, the tangential displacement (xyz, m)
+/// and the sliding flag (w): the contact lists store it as such (contact/contact_lists.cuh).
+#include <sstream>
+#include <string>
+
+namespace sphere {
+
+/// A law's time-step rule: dt = default_factor * T unless the user sets one, and no dt above
+/// bound_factor * T is accepted, with T the smallest of the law's time scale over the
+/// particles (docs/physics.md, "Time step"); `scale` writes T as a formula.
+struct time_step_rule {
+    double default_factor;
+    double bound_factor;
+    const char* scale;
+
+    /// The bound as a formula, e.g. "0.3 sqrt(m / k_max)".
+    std::string bound_formula() const
+    {
+        std::ostringstream out;
+        out << bound_factor << " " << scale;
+        return out.str();
+    }
+};
+
+} // namespace sphere
