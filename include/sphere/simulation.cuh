@@ -221,6 +221,7 @@ public:
         Law::validate(s.contact, s.wall);
         pair_params_ = Law::template pair_kernel<Real>(s.contact);
         wall_params_ = Law::template wall_kernel<Real>(s.contact, s.wall);
+        range_ = law_range<Law, Coord>(pair_params_);
         if (!isfinite(s.gravity))
             detail::fail("settings.gravity (", s.gravity.x, ", ", s.gravity.y, ", ", s.gravity.z, ") m/s^2 is not finite");
         if (!(s.skin >= 0) || !std::isfinite(s.skin))
@@ -275,7 +276,7 @@ public:
         const std::size_t n = particles.size();
         std::vector<particle<Coord>>().swap(particles); // copied: its memory is not held through the first build
         walls_ = wall_set<Coord>::from_world(s.box);
-        grid_ = neighbor_grid<Coord, Policy>(grid_geometry<Coord>::make(s.box, 2 * max_radius + s.skin, s.cell_size));
+        grid_ = neighbor_grid<Coord, Policy>(grid_geometry<Coord>::make(s.box, 2 * max_radius + s.skin + range_, s.cell_size));
         lists_ = contact_lists<Precision, Policy>(n, s.contact_forces);
         summation_ = interaction<Precision, Policy>::resolve(s.pair_summation);
         x_at_build_.resize(n);
@@ -608,7 +609,7 @@ private:
         // positions at the rebuild of each slot.
         grid_.build(context_, particles_.view(), x_at_build_.data());
         const grid_view<Coord> g = grid_.view();
-        lists_.rebuild(context_, g, walls_, settings_.skin, !settings_.reorder, totals);
+        lists_.rebuild(context_, g, walls_, settings_.skin + range_, !settings_.reorder, totals);
         interaction_.lists_changed();
         if (settings_.reorder) {
             particles_.permute(g.order, x_at_build_.data(), external_);
@@ -870,6 +871,7 @@ private:
 
     settings_type settings_;
     kernel_params pair_params_, wall_params_; ///< what the law's kernels receive for settings_.contact and .wall
+    Coord range_ = 0; ///< the largest gap at which the law acts (contact/law.cuh): the lists reach that much further
     vec3<Real> gravity_;                             ///< settings_.gravity in the particles' precision
     Coord dt_ = 0;
     Coord largest_radius_ = 0; ///< largest_radius()

@@ -1,6 +1,7 @@
 // Instantiates every kernel of the DEM core for sphere::cuda in float, double and mixed
-// precision, with every contact-law and integrator policy (Hertz-Mindlin in double), so that CI proves the CUDA backend
-// compiles and links, and ptxas reports every kernel's resources (tests/check_ptxas.py).
+// precision, with every contact-law and integrator policy (Hertz-Mindlin and capillary
+// cohesion in double), so that CI proves the CUDA backend compiles and links, and ptxas
+// reports every kernel's resources (tests/check_ptxas.py).
 // It is built, not run: build machines have no GPU.
 #include <sphere/dem.cuh>
 
@@ -22,6 +23,14 @@ void stiffen(sphere::hertz_params<Real>& p)
     p.youngs_modulus = Real(1e8);
     p.poisson_ratio = Real(0.3);
     p.restitution = Real(0.5);
+}
+
+template <class Real, class Base>
+void stiffen(sphere::capillary_params<Real, Base>& p)
+{
+    stiffen(static_cast<Base&>(p));
+    p.surface_tension = Real(0.072);
+    p.bridge_volume = Real(1e-9);
 }
 
 template <class P, class Law, class Integrator>
@@ -72,6 +81,7 @@ int main()
     std::printf("%g\n", exercise_all<float>() + exercise_all<double>() +
                                 exercise<double, sphere::contact::linear<>, sphere::integrate::velocity_verlet>() +
                                 exercise<double, sphere::contact::hertz_mindlin<>, sphere::integrate::semi_implicit_euler>() +
+                                exercise<double, sphere::contact::capillary<>, sphere::integrate::semi_implicit_euler>() +
                                 exercise_step_shapes<sphere::mixed>());
     return 0;
 }

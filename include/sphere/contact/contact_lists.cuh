@@ -74,24 +74,25 @@ SPHERE_HDI bool has_history(const vec4<Real>& h)
     return h.x != Real(0) || h.y != Real(0) || h.z != Real(0) || h.w != Real(0);
 }
 
-/// Where the contact histories live: each entry's tangential displacement (m) and its
-/// sliding flag, in two arrays (25 B per entry in double, where one vec4 takes 32). Kernels
-/// read and write an entry as the vec4 the contact laws take: displacement in xyz, sliding
-/// flag (0 or 1) in w.
+/// Where the contact histories live: each entry's tangential displacement (m) and its flags,
+/// in two arrays (25 B per entry in double, where one vec4 takes 32). Kernels read and write an
+/// entry as the vec4 the contact laws take: displacement in xyz, flags in w as a whole number
+/// from 0 to 255 (bit 0: sliding, the tangential laws'; bit 1: a liquid bridge,
+/// contact::capillary's).
 template <class Real>
 struct history_view {
     vec3<Real>* shift;
-    std::uint8_t* sliding;
+    std::uint8_t* flags;
 
     SPHERE_HDI vec4<Real> load(std::size_t k) const
     {
         const vec3<Real> d = shift[k];
-        return {d.x, d.y, d.z, sliding[k] ? Real(1) : Real(0)};
+        return {d.x, d.y, d.z, Real(flags[k])};
     }
     SPHERE_HDI void store(std::size_t k, const vec4<Real>& h) const
     {
         shift[k] = {h.x, h.y, h.z};
-        sliding[k] = h.w != Real(0);
+        flags[k] = static_cast<std::uint8_t>(h.w);
     }
 };
 
@@ -101,28 +102,28 @@ class history_store {
 public:
     history_store() = default;
     /// n entries without history
-    explicit history_store(std::size_t n) : shift_(n, vec3<Real>{0, 0, 0}), sliding_(n, std::uint8_t(0)) {}
+    explicit history_store(std::size_t n) : shift_(n, vec3<Real>{0, 0, 0}), flags_(n, std::uint8_t(0)) {}
 
     std::size_t size() const { return shift_.size(); }
-    history_view<Real> view() { return {shift_.data(), sliding_.data()}; }
+    history_view<Real> view() { return {shift_.data(), flags_.data()}; }
     /// n entries; those already there keep their values.
     void resize(std::size_t n)
     {
         shift_.resize(n, vec3<Real>{0, 0, 0});
-        sliding_.resize(n, std::uint8_t(0));
+        flags_.resize(n, std::uint8_t(0));
     }
     void swap(history_store& other) noexcept
     {
         shift_.swap(other.shift_);
-        sliding_.swap(other.sliding_);
+        flags_.swap(other.flags_);
     }
-    /// A host copy, one vec4 per entry (xyz displacement, w sliding flag).
+    /// A host copy, one vec4 per entry (xyz displacement, w flags).
     std::vector<vec4<Real>> to_host() const
     {
         const std::vector<vec3<Real>> d = shift_.to_host();
-        const std::vector<std::uint8_t> s = sliding_.to_host();
+        const std::vector<std::uint8_t> s = flags_.to_host();
         std::vector<vec4<Real>> out(d.size());
-        for (std::size_t k = 0; k < d.size(); ++k) out[k] = {d[k].x, d[k].y, d[k].z, s[k] ? Real(1) : Real(0)};
+        for (std::size_t k = 0; k < d.size(); ++k) out[k] = {d[k].x, d[k].y, d[k].z, Real(s[k])};
         return out;
     }
     void assign(const std::vector<vec4<Real>>& h)
@@ -131,15 +132,15 @@ public:
         std::vector<std::uint8_t> s(h.size());
         for (std::size_t k = 0; k < h.size(); ++k) {
             d[k] = {h[k].x, h[k].y, h[k].z};
-            s[k] = h[k].w != Real(0);
+            s[k] = h[k].w >= Real(0) && h[k].w < Real(256) ? static_cast<std::uint8_t>(h[k].w) : std::uint8_t(0);
         }
         shift_.assign(std::move(d));
-        sliding_.assign(std::move(s));
+        flags_.assign(std::move(s));
     }
 
 private:
     buffer<vec3<Real>, Policy> shift_;
-    buffer<std::uint8_t, Policy> sliding_;
+    buffer<std::uint8_t, Policy> flags_;
 };
 
 /// Kernel view of the contact lists.

@@ -9,6 +9,7 @@
 #include "../particles/state.cuh"
 #include "contact_lists.cuh"
 #include "evaluate.cuh"
+#include "law.cuh"
 #include "result.cuh"
 
 namespace sphere {
@@ -78,7 +79,8 @@ struct particle_energy {
                 const vec4<Coord> xj = p.x[j];
                 const vec3<Coord> d = box.nearest_image_inside(xi.xyz() - xj.xyz());
                 const Coord dist2 = norm2(d), reach = xi.w + xj.w;
-                if (!(dist2 < reach * reach)) continue;
+                const Coord cut = acts_apart<Law>::value ? reach + law_range<Law, Coord>(pair_params) : reach;
+                if (!(dist2 < cut * cut)) continue;
                 contact_geometry<Real> g;
                 g.delta_n = overlap_and_normal(d, dist2, reach, g.n);
                 g.r_i = Real(xi.w);
@@ -87,7 +89,8 @@ struct particle_energy {
                 g.m_i = p.mass[i];
                 g.m_j = p.mass[j];
                 g.m_eff = g.m_i * g.m_j / (g.m_i + g.m_j);
-                if (g.delta_n < Real(0)) e.elastic += Coord(Law::pair_energy(pair_params, g, c.history.load(k)));
+                if (acts_apart<Law>::value || g.delta_n < Real(0))
+                    e.elastic += Coord(Law::pair_energy(pair_params, g, c.history.load(k)));
             } else {
                 const int f = static_cast<int>(j - wall_partner_base);
                 const int a = f / 2;

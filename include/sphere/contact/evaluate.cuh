@@ -24,6 +24,7 @@
 #include "../core/constants.cuh"
 #include "../particles/state.cuh"
 #include "contact_lists.cuh"
+#include "law.cuh"
 #include "result.cuh"
 
 namespace sphere {
@@ -82,9 +83,18 @@ struct pair_contact {
     typename Law::template kernel_params<Real> params;
     Real dt;
 
+    /// Whether the law acts on a pair at squared distance dist2 (m^2) whose radii sum to reach
+    /// (m): distinct centres that overlap, or for a law that acts apart (contact/law.cuh) lie
+    /// within its range of touching.
+    SPHERE_HDI bool acts(Coord dist2, Coord reach) const
+    {
+        const Coord cut = acts_apart<Law>::value ? reach + law_range<Law, Coord>(params) : reach;
+        return dist2 < cut * cut && dist2 > Coord(0);
+    }
+
     /// The contact of i (owner) and j (slots) with history h (updated): both particles'
-    /// share, or zero when they do not touch (overlap with distinct centres), which also
-    /// resets the history. `Branchless` evaluates the law whatever the distance and selects the
+    /// share, or zero when the law does not act on them (acts()), which also resets the
+    /// history. `Branchless` evaluates the law whatever the distance and selects the
     /// result, so that a loop over pairs vectorises (non-touching pairs may then produce
     /// non-finite intermediates, which are discarded); otherwise non-touching pairs return
     /// early.
@@ -94,7 +104,7 @@ struct pair_contact {
         const vec4<Coord> xi = p.x[i], xj = p.x[j];
         vec3<Coord> d = box.nearest_image_inside(xi.xyz() - xj.xyz());
         const Coord dist2 = norm2(d), reach = xi.w + xj.w;
-        const bool touching = dist2 < reach * reach && dist2 > Coord(0);
+        const bool touching = acts(dist2, reach);
         if constexpr (!Branchless) {
             if (!touching) {
                 h = vec4<Real>{0, 0, 0, 0}; // a contact that has ended forgets its history

@@ -86,7 +86,7 @@ struct slab_pairs {
                 t.entry[t.count] = e;
                 // the sliding flag goes into the tile here: the SIMD loop gathers the
                 // displacements, but cannot gather bytes
-                t.hw[t.count] = c.history.sliding[e] ? Real(1) : Real(0);
+                t.hw[t.count] = Real(c.history.flags[e]);
                 if constexpr (touching_lanes_only) {
                     // Only touching pairs take a lane; the others only forget their history.
                     // Both lists grow without a branch on the outcome, which no predictor
@@ -94,7 +94,7 @@ struct slab_pairs {
                     const vec4<Coord> xj = p.x[j];
                     vec3<Coord> d = eval.box.nearest_image_inside(xi.xyz() - xj.xyz());
                     const Coord dist2 = norm2(d), reach = xi.w + xj.w;
-                    const bool touching = dist2 < reach * reach && dist2 > Coord(0);
+                    const bool touching = eval.acts(dist2, reach);
                     apart[apart_count] = e;
                     t.count += touching;
                     apart_count += !touching;

@@ -30,12 +30,39 @@
 /// calling f(name, field, unit) for every field (a floating value, a bool or an enumeration
 /// with largest_value()), which checkpoints and the precision checks use.
 ///
+/// A law that also acts between particles that do not touch (a liquid bridge) declares
+///
+///     static constexpr bool acts_apart = true;
+///     template <class Real>   // the largest gap (m) at which it acts between two particles
+///     SPHERE_HDI static Real range(const kernel_params<Real>&);
+///
+/// and then receives pairs with 0 <= delta_n < range too; pair_energy likewise. The contact
+/// lists reach that much further. Walls see contacts only (delta_n < 0).
+///
 /// The history of a contact is, for every law so far, the tangential displacement (xyz, m)
-/// and the sliding flag (w): the contact lists store it as such (contact/contact_lists.cuh).
+/// and whole-number flags (w, 0 to 255): the contact lists store it as such
+/// (contact/contact_lists.cuh).
 #include <sstream>
 #include <string>
+#include <type_traits>
+
+#include "../core/config.cuh"
 
 namespace sphere {
+
+/// Whether Law acts between particles that do not touch (Law::acts_apart).
+template <class Law, class = void>
+struct acts_apart : std::false_type {};
+template <class Law>
+struct acts_apart<Law, std::enable_if_t<Law::acts_apart>> : std::true_type {};
+
+/// The largest gap (m) at which Law acts between two particles: 0 for a contact law.
+template <class Law, class Real, class KernelParams>
+SPHERE_HDI Real law_range(const KernelParams& p)
+{
+    if constexpr (acts_apart<Law>::value) return Real(Law::range(p));
+    else return Real(0);
+}
 
 /// A law's time-step rule: dt = default_factor * T unless the user sets one, and no dt above
 /// bound_factor * T is accepted, with T the smallest of the law's time scale over the

@@ -1,0 +1,194 @@
+#pragma once
+/// \file
+/// Capillary cohesion (the seeds' `capillaryCohesion`): a liquid bridge between two particles
+/// added to any contact law (the interface of contact/law.cuh). A bridge forms when the
+/// particles touch and pulls them together until their gap exceeds the rupture distance.
+/// Force: Rabinovich et al. (2005), Langmuir 21:5526, sphere-sphere with a constant bridge
+/// volume; rupture distance: Lian et al. (1993), J. Colloid Interface Sci. 161:138.
+/// Equations and units: docs/physics.md, "Capillary cohesion".
+#include <cmath>
+#include <string>
+
+#include "../core/constants.cuh"
+#include "../core/error.cuh"
+#include "../core/vec.cuh"
+#include "law.cuh"
+#include "linear.cuh"
+#include "result.cuh"
+
+namespace sphere {
+
+/// The parameters of a base law plus those of the liquid bridges between particles, SI
+/// units. In settings.wall only the base law's fields are used: bridges form between
+/// particles, not at walls.
+template <class Real, class Base>
+struct capillary_params : Base {
+    Real surface_tension = 0; ///< gamma (N/m), >= 0
+    Real contact_angle = 0;   ///< theta (rad), 0 <= theta < pi/2
+    Real bridge_volume = 0;   ///< V, the liquid volume of each bridge (m^3), > 0
+
+    /// Calls f(name, field, unit) for every field: the base law's, then the bridge's.
+    template <class Self, class F>
+    static void fields(Self& p, F&& f)
+    {
+        Base::fields(p, f);
+        f("surface_tension", p.surface_tension, "N/m");
+        f("contact_angle", p.contact_angle, "rad");
+        f("bridge_volume", p.bridge_volume, "m^3");
+    }
+};
+
+/// What the kernels receive: the base law's kernel parameters and the bridge's.
+template <class Real, class BaseKernel>
+struct capillary_contact {
+    BaseKernel base;
+    Real tension;  ///< 2 pi gamma cos(theta) (N/m): the pull at contact per unit R
+    Real volume;   ///< V (m^3)
+    Real rupture;  ///< H_r = (1 + theta / 2) V^(1/3) (m)
+};
+
+namespace contact {
+
+/// Capillary cohesion on top of the contact law `Base`. With R = 2 R* (the harmonic mean of
+/// the radii), H >= 0 the gap and a = 2 V / (pi R), a bridge pulls each particle towards the
+/// other with
+///   F(H) = 2 pi R gamma cos(theta) (1 - H / sqrt(H^2 + a))        (N; 0 <= H < H_r)
+/// and with F(0) while the particles overlap, on top of the base law's forces.
+template <class Base = linear<>>
+struct capillary {
+    using base_law = Base;
+    template <class Real>
+    using params = capillary_params<Real, typename Base::template params<Real>>;
+    template <class Real>
+    using kernel_params = capillary_contact<Real, typename Base::template kernel_params<Real>>;
+
+    static std::string name() { return "capillary<" + Base::name() + ">"; }
+    static constexpr const char* history_layout =
+        "tangential displacement (m) xyz, flags w (bit 0 sliding, bit 1 liquid bridge)";
+    static constexpr time_step_rule time_step = Base::time_step;
+    static constexpr bool acts_apart = true;
+
+    /// Throws sphere::error naming the first bad parameter.
+    template <class Real>
+    static void validate(const params<Real>& pair, const params<Real>& wall)
+    {
+        Base::validate(pair, wall);
+        const char* where = "settings.contact";
+        if (!(pair.surface_tension >= 0) || !std::isfinite(pair.surface_tension))
+            detail::fail(where, ".surface_tension = ", pair.surface_tension, " N/m: must be non-negative and finite");
+        if (!(pair.contact_angle >= 0 && pair.contact_angle < Real(pi<double> / 2)))
+            detail::fail(where, ".contact_angle = ", pair.contact_angle, " rad: must lie in [0, pi/2)");
+        if (!(pair.bridge_volume > 0) || !std::isfinite(pair.bridge_volume))
+            detail::fail(where, ".bridge_volume = ", pair.bridge_volume, " m^3: must be positive and finite");
+    }
+
+    template <class Real, class From>
+    static kernel_params<Real> pair_kernel(const params<From>& pair)
+    {
+        const double theta = double(pair.contact_angle), v = double(pair.bridge_volume);
+        return {Base::template pair_kernel<Real>(pair), Real(2 * pi<double> * double(pair.surface_tension) * std::cos(theta)),
+                Real(v), Real((1 + theta / 2) * std::cbrt(v))};
+    }
+    template <class Real, class From>
+    static kernel_params<Real> wall_kernel(const params<From>& pair, const params<From>& wall)
+    {
+        return {Base::template wall_kernel<Real>(pair, wall), Real(0), Real(0), Real(0)};
+    }
+
+    template <class Real>
+    static Real time_scale(const params<Real>& pair, const params<Real>& wall, Real mass, Real radius)
+    {
+        return Base::time_scale(pair, wall, mass, radius);
+    }
+    template <class Real>
+    static std::string time_scale_inputs(const params<Real>& pair, const params<Real>& wall, Real mass, Real radius)
+    {
+        return Base::time_scale_inputs(pair, wall, mass, radius);
+    }
+
+    /// The rupture distance H_r (m).
+    template <class Real>
+    SPHERE_HDI static Real range(const kernel_params<Real>& p)
+    {
+        return p.rupture;
+    }
+
+    /// The bridge's pull F(H) (N) at gap `gap` (0 while overlapping) for R = 2 R*.
+    template <class Real>
+    SPHERE_HDI static Real pull(const kernel_params<Real>& p, Real r, Real gap)
+    {
+        const Real a = Real(2) * p.volume / (pi<Real> * r);
+        return p.tension * r * (Real(1) - gap / std::sqrt(gap * gap + a));
+    }
+
+    /// The bridge's potential energy (J, <= 0, zero at rupture): minus the work its pull does
+    /// from here to the rupture distance, U(H) = -F(0) (H_r - H - sqrt(H_r^2 + a) + sqrt(H^2 + a))
+    /// at a gap H = delta_n >= 0, and U(0) + F(0) delta_n while overlapping (docs/physics.md,
+    /// "Capillary cohesion"); r = 2 R*.
+    template <class Real>
+    SPHERE_HDI static Real bridge_energy(const kernel_params<Real>& p, Real r, Real delta_n)
+    {
+        const Real a = Real(2) * p.volume / (pi<Real> * r);
+        const Real h = delta_n > Real(0) ? delta_n : Real(0), inside = delta_n > Real(0) ? Real(0) : delta_n;
+        const Real hr = p.rupture;
+        return -p.tension * r * (hr - h - std::sqrt(hr * hr + a) + std::sqrt(h * h + a) - inside);
+    }
+
+    /// A pair: the base law while the particles overlap, the bridge's pull while one exists.
+    /// A bridge forms on contact; its potential energy at that moment is booked as dissipated
+    /// (the energy the liquid's surface releases), so that the budget closes.
+    template <class Real>
+    SPHERE_HDI static contact_result<Real> pair(const kernel_params<Real>& p, const contact_motion<Real>& m,
+                                               vec4<Real>& h, Real dt)
+    {
+        const bool had_bridge = h.w >= Real(2);
+        vec4<Real> hb{h.x, h.y, h.z, had_bridge ? h.w - Real(2) : h.w};
+        const bool touching = m.delta_n < Real(0);
+        // Evaluated whatever the overlap (branchless), kept only while touching.
+        contact_result<Real> c = Base::pair(p.base, m, hb, dt);
+        const vec3<Real> zero{0, 0, 0};
+        const bool bridge = touching || (had_bridge && m.delta_n < p.rupture);
+        const Real r = Real(2) * m.r_eff;
+        const Real gap = touching ? Real(0) : m.delta_n;
+        const Real f = bridge ? pull(p, r, gap) : Real(0);
+        const Real formed = bridge && !had_bridge ? -bridge_energy(p, r, m.delta_n) / dt : Real(0);
+        contact_result<Real> out;
+        out.normal = select(touching, c.normal, zero) - m.n * f;
+        out.tangential = select(touching, c.tangential, zero);
+        out.fn = touching ? c.fn : Real(0);
+        out.visc_rate = (touching ? c.visc_rate : Real(0)) + formed;
+        out.fric_rate = touching ? c.fric_rate : Real(0);
+        hb = select(touching, hb, vec4<Real>{0, 0, 0, 0});
+        h = {hb.x, hb.y, hb.z, hb.w + (bridge ? Real(2) : Real(0))};
+        return out;
+    }
+
+    /// A wall contact: the base law's (no bridges at walls).
+    template <class Real>
+    SPHERE_HDI static contact_result<Real> wall(const kernel_params<Real>& p, const contact_motion<Real>& m,
+                                               vec4<Real>& h, Real dt)
+    {
+        return Base::wall(p.base, m, h, dt);
+    }
+
+    /// The base law's springs while overlapping, plus the bridge's potential energy (J).
+    template <class Real>
+    SPHERE_HDI static Real pair_energy(const kernel_params<Real>& p, const contact_geometry<Real>& g,
+                                      const vec4<Real>& h)
+    {
+        const bool bridge = h.w >= Real(2);
+        const vec4<Real> hb{h.x, h.y, h.z, bridge ? h.w - Real(2) : h.w};
+        const Real spring = g.delta_n < Real(0) ? Base::pair_energy(p.base, g, hb) : Real(0);
+        return spring + (bridge ? bridge_energy(p, Real(2) * g.r_eff, g.delta_n) : Real(0));
+    }
+
+    template <class Real>
+    SPHERE_HDI static Real wall_energy(const kernel_params<Real>& p, const contact_geometry<Real>& g,
+                                      const vec4<Real>& h)
+    {
+        return Base::wall_energy(p.base, g, h);
+    }
+};
+
+} // namespace contact
+} // namespace sphere
