@@ -2,8 +2,8 @@
 /// \file
 /// What a contact law declares, and the time-step rule built on it.
 ///
-/// A contact law is a type `Law` with (contact/linear.cuh and contact/hertz_mindlin.cuh are
-/// the examples; docs/architecture.md, "Contact laws"):
+/// A contact law is a type `Law` with (contact/linear.cuh, contact/hertz_mindlin.cuh and
+/// contact/capillary.cuh are the examples; docs/architecture.md, "Policy types"):
 ///
 ///     template <class Real> using params = ...;         // the user's parameters, in settings
 ///                                                      // (.contact for pairs, .wall for walls)
