@@ -37,6 +37,7 @@
 #include "particles/state.cuh"
 #include "particles/validate.cuh"
 #include "settings.cuh"
+#include "setup/insertion.cuh"
 #include "setup/layers.cuh"
 #include "setup/packing.cuh"
 #include "simulation.cuh"

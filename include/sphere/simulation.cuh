@@ -588,6 +588,76 @@ public:
         drift_checked_ = false;
     }
 
+    /// Adds particles during a run (particle insertion): they take the user indices size() to
+    /// size() + added.size() - 1, and every other particle, contact history, wall and
+    /// observer carries on; the time step stays. Throws sphere::error (naming the added
+    /// particle by its new index) for a particle that is invalid, lies outside the world or
+    /// beyond a wall, overlaps any particle, or is lighter than the time step allows, and
+    /// while external forces (a coupled fluid) act; the simulation is then unchanged. An
+    /// insertion builds the simulation's arrays anew: O(N), meant for occasional batches
+    /// (setup/insertion.cuh inserts at a rate).
+    void insert(const std::vector<particle<Coord>>& added)
+    {
+        if (added.empty()) return;
+        if (external_.size())
+            detail::fail("insert: particles cannot be added while external forces act (a coupled fluid sizes them)");
+        const std::size_t n = size();
+        simulation_state<Coord> st = state();
+        std::vector<particle<Coord>> all(n + added.size());
+        for (std::size_t i = 0; i < n; ++i) {
+            const double r = double(st.particles.x[i].w);
+            all[i].position = st.particles.position(i);
+            all[i].radius = st.particles.x[i].w;
+            all[i].density = Coord(double(st.particles.mass[i]) / (4.0 / 3.0 * pi<double> * r * r * r));
+            all[i].velocity = st.particles.v[i];
+            all[i].angular_velocity = st.particles.omega[i];
+            all[i].kind = kinds_[i];
+        }
+        for (std::size_t k = 0; k < added.size(); ++k) all[n + k] = added[k];
+        validate_particles(all, settings_.box);
+        for (std::size_t k = 0; k < added.size(); ++k) {
+            const std::size_t i = n + k;
+            const particle<Coord>& a = added[k];
+            for (int f = 0; f < wall_set<Coord>::count; ++f) {
+                const wall_face<Coord>& w = walls_.face[f];
+                const int axis = f / 2;
+                const double reach = f % 2 == 0 ? double(a.position[axis]) - w.position : w.position - double(a.position[axis]);
+                if (w.active && reach < double(a.radius))
+                    detail::fail("insert: particle ", i, " at ", a.position[axis], " m on axis ", axis, " (radius ",
+                                 a.radius, " m) crosses wall face ", f, " at ", w.position, " m");
+            }
+            for (std::size_t j = 0; j < i; ++j) {
+                const vec3<Coord> d = settings_.box.nearest_image_inside(a.position - all[j].position);
+                const Coord reach = a.radius + all[j].radius;
+                if (norm2(d) < reach * reach)
+                    detail::fail("insert: particle ", i, " overlaps particle ", j, ": centres ", std::sqrt(double(norm2(d))),
+                                 " m apart, radii ", a.radius, " and ", all[j].radius, " m");
+            }
+        }
+        settings_type s = settings_;
+        s.dt = dt_;
+        simulation next(s, all);
+        particle_snapshot<Coord>& ps = st.particles;
+        for (const particle<Coord>& a : added) {
+            ps.x.push_back({a.position.x, a.position.y, a.position.z, a.radius});
+            ps.v.push_back(a.velocity);
+            ps.omega.push_back(a.angular_velocity);
+            ps.v_sync.push_back(a.velocity);
+            ps.omega_sync.push_back(a.angular_velocity);
+            for (auto* field : {&ps.angpos, &ps.force, &ps.torque}) field->push_back({0, 0, 0});
+            ps.mass.push_back(sphere_mass(a.radius, a.density));
+            for (auto* field : {&ps.pressure, &ps.e_visc, &ps.e_fric, &ps.p_visc, &ps.p_fric}) field->push_back(0);
+            ps.kind.push_back(static_cast<std::uint8_t>(a.kind));
+            st.contacts.offset.push_back(st.contacts.offset.back());
+            st.x_at_build.push_back(ps.x.back());
+            st.storage.push_back(static_cast<unsigned>(st.storage.size()));
+        }
+        st.needs_rebuild = true;
+        next.restore(st);
+        next.observers_ = std::move(observers_);
+        *this = std::move(next);
+    }
+
     /// Total linear momentum, sum m v (kg m/s), summed in rank order.
     vec3<Coord> momentum() const
     {
