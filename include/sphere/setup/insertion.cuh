@@ -1,7 +1,8 @@
 #pragma once
 /// \file
 /// Inserting particles during a run, as LIGGGHTS users fill a silo: a region, a rate, radii
-/// uniform in a range, no overlap at insertion (simulation::insert does the adding).
+/// uniform or log-normal within a range, no overlap at insertion (simulation::insert does the
+/// adding).
 /// Host-only set-up code; the random choices use random_stream, so a seed and the same run
 /// give the same particles.
 #include <cmath>
@@ -16,12 +17,21 @@
 
 namespace sphere {
 
+/// How an inserter draws radii.
+enum class radius_distribution : std::uint8_t {
+    uniform = 0,   ///< uniform in [radius_min, radius_max]
+    lognormal = 1, ///< log-normal with radius_mean and radius_stddev (lognormal_from_moments),
+                   ///< drawn again until it lies in [radius_min, radius_max]
+};
+
 /// Where, how fast and which particles an inserter adds (SI units).
 template <class Real>
 struct insertion_settings {
     vec3<Real> lo{0, 0, 0}, hi{0, 0, 0}; ///< the region the particles are placed in (m): whole particles inside
     double rate = 0;                     ///< particles per second of simulated time, > 0
-    Real radius_min = 0, radius_max = 0; ///< radii uniform in [radius_min, radius_max] (m)
+    Real radius_min = 0, radius_max = 0; ///< the range of the radii (m)
+    radius_distribution distribution = radius_distribution::uniform;
+    Real radius_mean = 0, radius_stddev = 0; ///< of the log-normal radii (m); the mean within the range
     Real density = 0;                    ///< (kg/m^3), > 0
     vec3<Real> velocity{0, 0, 0};        ///< initial velocity (m/s)
     std::size_t total = 0;               ///< particles to insert in all; 0: no limit
@@ -57,6 +67,14 @@ public:
                 detail::fail("insertion_settings: the region spans [", s.lo[a], ", ", s.hi[a], "] m on axis ", a,
                              ", too little for a particle of radius ", s.radius_max, " m");
         if (s.tries == 0) detail::fail("insertion_settings.tries = 0: at least one candidate is needed");
+        if (s.distribution == radius_distribution::lognormal) {
+            if (!(s.radius_mean >= s.radius_min && s.radius_mean <= s.radius_max))
+                detail::fail("insertion_settings.radius_mean = ", s.radius_mean, " m lies outside [radius_min, radius_max] = [",
+                             s.radius_min, ", ", s.radius_max, "] m");
+            lognormal_ = lognormal_from_moments(double(s.radius_mean), double(s.radius_stddev));
+        } else if (s.distribution != radius_distribution::uniform) {
+            detail::fail("insertion_settings.distribution = ", unsigned(s.distribution), ": not a radius_distribution");
+        }
     }
 
     /// Inserts the particles due by sim.time(); returns how many it inserted.
@@ -82,7 +100,7 @@ public:
         std::vector<particle<Real>> added;
         for (std::size_t k = inserted_; k < due; ++k) {
             if (!has_radius_) {
-                radius_ = Real(rng_.uniform(double(s_.radius_min), double(s_.radius_max)));
+                radius_ = draw_radius();
                 has_radius_ = true;
             }
             vec3<Real> centre{0, 0, 0};
@@ -121,7 +139,18 @@ public:
     std::size_t waiting() const { return waiting_; }
 
 private:
+    Real draw_radius()
+    {
+        if (s_.distribution == radius_distribution::uniform)
+            return Real(rng_.uniform(double(s_.radius_min), double(s_.radius_max)));
+        for (;;) { // the mean lies in the range, so a draw lands there with probability > 0
+            const Real r = Real(std::exp(lognormal_.mu + lognormal_.sigma * rng_.normal()));
+            if (r >= s_.radius_min && r <= s_.radius_max) return r;
+        }
+    }
+
     insertion_settings<Real> s_;
+    lognormal_parameters lognormal_{0, 0};
     double start_;
     random_stream rng_;
     std::size_t inserted_ = 0, waiting_ = 0;
