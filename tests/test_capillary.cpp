@@ -52,6 +52,61 @@ double pull(double r0, double r1, double theta, double h)
 
 double rupture(double theta) { return (1 + theta / 2) * std::cbrt(bridge_volume); }
 
+constexpr double pair_radius = 0.01, pair_speed = 0.1;
+
+/// Two particles of radius 1 cm meeting head-on along x at 0.1 m/s, 0.2 mm apart.
+template <class Real>
+std::vector<sphere::particle<Real>> colliding_pair()
+{
+    std::vector<sphere::particle<Real>> ps(2);
+    for (int i = 0; i < 2; ++i) {
+        ps[i].position = {Real(i == 0 ? -pair_radius - 1e-4 : pair_radius + 1e-4), 0, 0};
+        ps[i].radius = Real(pair_radius);
+        ps[i].density = Real(2500);
+        ps[i].velocity = {Real(i == 0 ? pair_speed / 2 : -pair_speed / 2), 0, 0};
+    }
+    return ps;
+}
+
+/// The energy a bridge between two 1 cm particles takes from their motion,
+/// W = F(0) (H_r + sqrt(a) - sqrt(H_r^2 + a)) at theta = 0 (J).
+double bridge_work()
+{
+    const double r = pair_radius, a = 2 * bridge_volume / (pi * r), hr = rupture(0);
+    return 2 * pi * r * surface_tension * (hr + std::sqrt(a) - std::sqrt(hr * hr + a));
+}
+
+/// What the colliding pair's run through a bridge did (J): the largest error of the energy
+/// budget at any step, the error at the end, the kinetic energy before and its loss.
+struct bridge_collision {
+    double worst, last, ke0, lost;
+};
+
+/// Runs the colliding pair under settings s at the default dt / 10 until the particles are
+/// 1.5 H_r apart.
+template <class Sim>
+bridge_collision collide(typename Sim::settings_type s)
+{
+    using Real = typename Sim::real_type;
+    const std::vector<sphere::particle<Real>> ps = colliding_pair<Real>();
+    s.dt = Real(Sim(s, ps).dt() / 10);
+    Sim sim(s, ps);
+    const double total0 = double(sim.energy().total());
+    bridge_collision out{0, 0, double(sim.energy().kinetic), 0};
+    bool apart = false;
+    for (int k = 0; k < 100000 && !apart; ++k) {
+        sim.step();
+        out.worst = std::fmax(out.worst, std::fabs(double(sim.energy().total()) - total0));
+        const auto snap = sim.snapshot();
+        apart = double(snap.x[1].x) - double(snap.x[0].x) - 2 * pair_radius > 1.5 * rupture(0);
+    }
+    REQUIRE(apart);
+    REQUIRE(double(sim.energy().elastic) == 0); // the bridge is gone
+    out.last = std::fabs(double(sim.energy().total()) - total0);
+    out.lost = out.ke0 - double(sim.energy().kinetic);
+    return out;
+}
+
 } // namespace
 
 TEMPLATE_TEST_CASE("capillary: the force-distance curve of a bridge pulled apart, and its rupture", "[capillary]",
@@ -124,35 +179,10 @@ TEMPLATE_TEST_CASE("capillary: a colliding pair loses the bridge's energy, and t
     // the spring's energy at contact entry, O(dt^2)); the kinetic energy lost is the energy
     // W = F(0) (H_r + sqrt(a) - sqrt(H_r^2 + a)) the bridge took, within 1% (plus F(0) times the
     // overlap of the step it formed on, and the integrator's error; 3% with float positions).
-    using Real = user_real<TestType>;
-    const double r = 0.01, v = 0.1;
-    std::vector<sphere::particle<Real>> ps(2);
-    for (int i = 0; i < 2; ++i) {
-        ps[i].position = {Real(i == 0 ? -r - 1e-4 : r + 1e-4), 0, 0};
-        ps[i].radius = Real(r);
-        ps[i].density = Real(2500);
-        ps[i].velocity = {Real(i == 0 ? v / 2 : -v / 2), 0, 0};
-    }
-    typename wet_sim<TestType>::settings_type st = wet_box<TestType>(0);
-    st.dt = Real(wet_sim<TestType>(st, ps).dt() / 10);
-    wet_sim<TestType> sim(st, ps);
-    const double total0 = double(sim.energy().total()), ke0 = double(sim.energy().kinetic);
-    double worst = 0;
-    bool apart = false;
-    for (int k = 0; k < 100000 && !apart; ++k) {
-        sim.step();
-        worst = std::fmax(worst, std::fabs(double(sim.energy().total()) - total0));
-        const auto s = sim.snapshot();
-        apart = double(s.x[1].x) - double(s.x[0].x) - 2 * r > 1.5 * rupture(0);
-    }
-    REQUIRE(apart);
-    CHECK(worst < (sphere_test::single_fields<TestType> ? 1e-3 : 2e-4) * ke0);
-    const double a = 2 * bridge_volume / (pi * r), hr = rupture(0);
-    const double w = 2 * pi * r * surface_tension * (hr + std::sqrt(a) - std::sqrt(hr * hr + a));
-    const double lost = ke0 - double(sim.energy().kinetic);
+    const bridge_collision c = collide<wet_sim<TestType>>(wet_box<TestType>(0));
+    CHECK(c.worst < (sphere_test::single_fields<TestType> ? 1e-3 : 2e-4) * c.ke0);
     // float positions resolve the gap to ~1e-9 m, which the pull's work over 1 mm feels: 3%
-    CHECK(std::fabs(lost / w - 1) < (std::is_same_v<TestType, float> ? 0.03 : 0.01));
-    CHECK(double(sim.energy().elastic) == 0); // the bridge is gone
+    CHECK(std::fabs(c.lost / bridge_work() - 1) < (std::is_same_v<TestType, float> ? 0.03 : 0.01));
 }
 
 TEMPLATE_TEST_CASE("capillary: bad bridge parameters are refused by name", "[capillary][errors]", float, double)
@@ -180,18 +210,10 @@ TEMPLATE_TEST_CASE("capillary: a bridge survives a checkpoint", "[capillary][io]
     // restarted run continues bit for bit, bridge included.
     using Real = TestType;
     sphere_test::temp_folder dir("capillary_checkpoint");
-    const double r = 0.01, v = 0.1;
-    std::vector<sphere::particle<Real>> ps(2);
-    for (int i = 0; i < 2; ++i) {
-        ps[i].position = {Real(i == 0 ? -r - 1e-4 : r + 1e-4), 0, 0};
-        ps[i].radius = Real(r);
-        ps[i].density = Real(2500);
-        ps[i].velocity = {Real(i == 0 ? v / 2 : -v / 2), 0, 0};
-    }
-    wet_sim<Real> sim(wet_box<Real>(0), ps);
+    wet_sim<Real> sim(wet_box<Real>(0), colliding_pair<Real>());
     sim.run(200); // past the contact: 0.2 mm apart, the bridge pulling
     const auto mid = sim.snapshot();
-    const double gap = double(mid.x[1].x - mid.x[0].x) - 2 * r;
+    const double gap = double(mid.x[1].x - mid.x[0].x) - 2 * pair_radius;
     REQUIRE(gap > 0);
     REQUIRE(gap < rupture(0));
     REQUIRE(mid.force[0].x > 0);
@@ -223,29 +245,8 @@ TEMPLATE_TEST_CASE("capillary: bridges on the Hertz-Mindlin law", "[capillary][h
     s.contact.surface_tension = Real(surface_tension);
     s.contact.bridge_volume = Real(bridge_volume);
     s.wall = s.contact;
-    const double r = 0.01, v = 0.1;
-    std::vector<sphere::particle<Real>> ps(2);
-    for (int i = 0; i < 2; ++i) {
-        ps[i].position = {Real(i == 0 ? -r - 1e-4 : r + 1e-4), 0, 0};
-        ps[i].radius = Real(r);
-        ps[i].density = Real(2500);
-        ps[i].velocity = {Real(i == 0 ? v / 2 : -v / 2), 0, 0};
-    }
-    s.dt = Real(sim_t(s, ps).dt() / 10);
-    sim_t sim(s, ps);
-    const double total0 = double(sim.energy().total()), ke0 = double(sim.energy().kinetic);
-    double worst = 0;
-    bool apart = false;
-    for (int k = 0; k < 100000 && !apart; ++k) {
-        sim.step();
-        worst = std::fmax(worst, std::fabs(double(sim.energy().total()) - total0));
-        const auto snap = sim.snapshot();
-        apart = double(snap.x[1].x) - double(snap.x[0].x) - 2 * r > 1.5 * rupture(0);
-    }
-    REQUIRE(apart);
-    CHECK(worst < (sphere_test::single_fields<TestType> ? 1e-3 : 5e-4) * ke0);
-    CHECK(std::fabs(double(sim.energy().total()) - total0) < (sphere_test::single_fields<TestType> ? 1e-3 : 1e-4) * ke0);
-    const double a = 2 * bridge_volume / (pi * r), hr = rupture(0);
-    const double w = 2 * pi * r * surface_tension * (hr + std::sqrt(a) - std::sqrt(hr * hr + a));
-    CHECK(std::fabs((ke0 - double(sim.energy().kinetic)) / w - 1) < (std::is_same_v<TestType, float> ? 0.03 : 0.01));
+    const bridge_collision c = collide<sim_t>(s);
+    CHECK(c.worst < (sphere_test::single_fields<TestType> ? 1e-3 : 5e-4) * c.ke0);
+    CHECK(c.last < (sphere_test::single_fields<TestType> ? 1e-3 : 1e-4) * c.ke0);
+    CHECK(std::fabs(c.lost / bridge_work() - 1) < (std::is_same_v<TestType, float> ? 0.03 : 0.01));
 }
