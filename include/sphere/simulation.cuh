@@ -603,17 +603,8 @@ public:
             detail::fail("insert: particles cannot be added while external forces act (a coupled fluid sizes them)");
         const std::size_t n = size();
         simulation_state<Coord> st = state();
-        std::vector<particle<Coord>> all(n + added.size());
-        for (std::size_t i = 0; i < n; ++i) {
-            const double r = double(st.particles.x[i].w);
-            all[i].position = st.particles.position(i);
-            all[i].radius = st.particles.x[i].w;
-            all[i].density = Coord(double(st.particles.mass[i]) / (4.0 / 3.0 * pi<double> * r * r * r));
-            all[i].velocity = st.particles.v[i];
-            all[i].angular_velocity = st.particles.omega[i];
-            all[i].kind = kinds_[i];
-        }
-        for (std::size_t k = 0; k < added.size(); ++k) all[n + k] = added[k];
+        std::vector<particle<Coord>> all = st.particles.descriptions();
+        all.insert(all.end(), added.begin(), added.end());
         validate_particles(all, settings_.box);
         for (std::size_t k = 0; k < added.size(); ++k) {
             const std::size_t i = n + k;

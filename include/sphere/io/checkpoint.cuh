@@ -59,23 +59,8 @@ struct checkpoint_data {
     std::uint32_t written_precision = 0; ///< sizeof the writer's Real: 4 (float) or 8 (double)
 
     /// Particle descriptions from which a simulation with these settings is built before
-    /// restore(state): positions, radii, velocities and kinds of the state, densities from the
-    /// stored masses (mass / (4/3 pi r^3), in double).
-    std::vector<particle<Real>> particles() const
-    {
-        const particle_snapshot<Real>& s = state.particles;
-        std::vector<particle<Real>> out(s.size());
-        for (std::size_t i = 0; i < s.size(); ++i) {
-            const double r = double(s.x[i].w);
-            out[i].position = s.position(i);
-            out[i].radius = s.x[i].w;
-            out[i].density = Real(double(s.mass[i]) / (4.0 / 3.0 * pi<double> * r * r * r));
-            out[i].velocity = s.v[i];
-            out[i].angular_velocity = s.omega[i];
-            out[i].kind = static_cast<motion>(s.kind[i]);
-        }
-        return out;
-    }
+    /// restore(state) (particle_snapshot::descriptions).
+    std::vector<particle<Real>> particles() const { return state.particles.descriptions(); }
 };
 
 namespace detail {

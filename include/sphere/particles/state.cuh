@@ -87,6 +87,24 @@ struct particle_snapshot {
     std::size_t size() const { return x.size(); }
     vec3<Real> position(std::size_t i) const { return x[i].xyz(); }
     Real radius(std::size_t i) const { return x[i].w; }
+
+    /// Particle descriptions from which a simulation is built before it restores a state with
+    /// this snapshot (restarts, insertion): positions, radii, velocities and kinds, densities
+    /// from the masses (mass / (4/3 pi r^3), in double).
+    std::vector<particle<Real>> descriptions() const
+    {
+        std::vector<particle<Real>> out(size());
+        for (std::size_t i = 0; i < size(); ++i) {
+            const double r = double(x[i].w);
+            out[i].position = position(i);
+            out[i].radius = x[i].w;
+            out[i].density = Real(double(mass[i]) / (4.0 / 3.0 * pi<double> * r * r * r));
+            out[i].velocity = v[i];
+            out[i].angular_velocity = omega[i];
+            out[i].kind = static_cast<motion>(kind[i]);
+        }
+        return out;
+    }
 };
 
 /// The owning particle arrays, in precision P (core/precision.cuh); snapshots and particle
