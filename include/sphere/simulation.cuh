@@ -277,7 +277,7 @@ public:
         std::vector<particle<Coord>>().swap(particles); // copied: its memory is not held through the first build
         walls_ = wall_set<Coord>::from_world(s.box);
         grid_ = neighbor_grid<Coord, Policy>(grid_geometry<Coord>::make(s.box, 2 * max_radius + s.skin + range_, s.cell_size));
-        lists_ = contact_lists<Precision, Policy>(n, s.contact_forces);
+        lists_ = contact_lists<Precision, Policy>(n, s.contact_forces, law_history_shape<Law>::value);
         summation_ = interaction<Precision, Policy>::resolve(s.pair_summation);
         x_at_build_.resize(n);
         report_.resize(1);

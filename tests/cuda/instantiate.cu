@@ -1,6 +1,6 @@
 // Instantiates every kernel of the DEM core for sphere::cuda in float, double and mixed
-// precision, with every contact-law and integrator policy (Hertz-Mindlin and capillary
-// cohesion in double), so that CI proves the CUDA backend compiles and links, and ptxas
+// precision, with every contact-law and integrator policy (Hertz-Mindlin, capillary
+// cohesion and rolling resistance under it in double), so that CI proves the CUDA backend compiles and links, and ptxas
 // reports every kernel's resources (tests/check_ptxas.py).
 // It is built, not run: build machines have no GPU.
 #include <sphere/dem.cuh>
@@ -31,6 +31,14 @@ void stiffen(sphere::capillary_params<Real, Base>& p)
     stiffen(static_cast<Base&>(p));
     p.surface_tension = Real(0.072);
     p.bridge_volume = Real(1e-9);
+}
+
+template <class Real, class Base>
+void stiffen(sphere::rolling_params<Real, Base>& p)
+{
+    stiffen(static_cast<Base&>(p));
+    p.mu_r = p.mu_twist = Real(0.1);
+    p.k_r = p.k_twist = Real(1);
 }
 
 template <class P, class Law, class Integrator>
@@ -82,6 +90,8 @@ int main()
                                 exercise<double, sphere::contact::linear<>, sphere::integrate::velocity_verlet>() +
                                 exercise<double, sphere::contact::hertz_mindlin<>, sphere::integrate::semi_implicit_euler>() +
                                 exercise<double, sphere::contact::capillary<>, sphere::integrate::semi_implicit_euler>() +
+                                exercise<double, sphere::contact::capillary<sphere::contact::rolling<>>,
+                                         sphere::integrate::velocity_verlet>() +
                                 exercise_step_shapes<sphere::mixed>());
     return 0;
 }

@@ -12,6 +12,7 @@
 #include "../core/constants.cuh"
 #include "../core/error.cuh"
 #include "../core/vec.cuh"
+#include "history.cuh"
 #include "law.cuh"
 #include "linear.cuh"
 #include "result.cuh"
@@ -64,9 +65,15 @@ struct capillary {
 
     static std::string name() { return "capillary<" + Base::name() + ">"; }
     static constexpr const char* history_layout =
-        "tangential displacement (m) xyz, flags w (bit 0 sliding, bit 1 liquid bridge)";
+        law_history_shape<Base>::value.lanes == 0
+            ? "tangential displacement (m) xyz, flags w (bit 0 sliding, bit 1 liquid bridge)"
+            : "tangential displacement (m) xyz, flags w (bit 0 sliding, bit 1 liquid bridge); lanes: the base law's";
     static constexpr time_step_rule time_step = Base::time_step;
     static constexpr bool acts_apart = true;
+    static constexpr unsigned history_lanes = law_history_shape<Base>::value.lanes; // the base law's
+    static constexpr unsigned history_mirror = law_history_shape<Base>::value.mirror;
+    template <class Real>
+    using history = law_history_t<Base, Real>;
 
     /// Throws sphere::error naming the first bad parameter.
     template <class Real>
@@ -74,12 +81,10 @@ struct capillary {
     {
         Base::validate(pair, wall);
         const char* where = "settings.contact";
-        if (!(pair.surface_tension >= 0) || !std::isfinite(pair.surface_tension))
-            detail::fail(where, ".surface_tension = ", pair.surface_tension, " N/m: must be non-negative and finite");
+        detail::require_non_negative(where, "surface_tension", pair.surface_tension, "N/m");
         if (!(pair.contact_angle >= 0 && pair.contact_angle < Real(pi<double> / 2)))
             detail::fail(where, ".contact_angle = ", pair.contact_angle, " rad: must lie in [0, pi/2)");
-        if (!(pair.bridge_volume > 0) || !std::isfinite(pair.bridge_volume))
-            detail::fail(where, ".bridge_volume = ", pair.bridge_volume, " m^3: must be positive and finite");
+        detail::require_positive(where, "bridge_volume", pair.bridge_volume, "m^3");
     }
 
     template <class Real, class From>
@@ -139,10 +144,11 @@ struct capillary {
     /// (the energy the liquid's surface releases), so that the budget closes.
     template <class Real>
     SPHERE_HDI static contact_result<Real> pair(const kernel_params<Real>& p, const contact_motion<Real>& m,
-                                               vec4<Real>& h, Real dt)
+                                               history<Real>& h, Real dt)
     {
-        const bool had_bridge = h.w >= Real(2);
-        vec4<Real> hb{h.x, h.y, h.z, had_bridge ? h.w - Real(2) : h.w};
+        const bool had_bridge = history_base(h).w >= Real(2);
+        history<Real> hb = h; // the base law's history: the flags without the bridge's bit
+        history_base(hb).w -= had_bridge ? Real(2) : Real(0);
         const bool touching = m.delta_n < Real(0);
         // Evaluated whatever the overlap (branchless), kept only while touching.
         contact_result<Real> c = Base::pair(p.base, m, hb, dt);
@@ -155,18 +161,19 @@ struct capillary {
         contact_result<Real> out;
         out.normal = select(touching, c.normal, zero) - m.n * f;
         out.tangential = select(touching, c.tangential, zero);
+        out.couple = select(touching, c.couple, zero);
         out.fn = touching ? c.fn : Real(0);
         out.visc_rate = (touching ? c.visc_rate : Real(0)) + formed;
         out.fric_rate = touching ? c.fric_rate : Real(0);
-        hb = select(touching, hb, vec4<Real>{0, 0, 0, 0});
-        h = {hb.x, hb.y, hb.z, hb.w + (bridge ? Real(2) : Real(0))};
+        h = select(touching, hb, history<Real>{});
+        history_base(h).w += bridge ? Real(2) : Real(0);
         return out;
     }
 
     /// A wall contact: the base law's (no bridges at walls).
     template <class Real>
     SPHERE_HDI static contact_result<Real> wall(const kernel_params<Real>& p, const contact_motion<Real>& m,
-                                               vec4<Real>& h, Real dt)
+                                               history<Real>& h, Real dt)
     {
         return Base::wall(p.base, m, h, dt);
     }
@@ -174,17 +181,18 @@ struct capillary {
     /// The base law's springs while overlapping, plus the bridge's potential energy (J).
     template <class Real>
     SPHERE_HDI static Real pair_energy(const kernel_params<Real>& p, const contact_geometry<Real>& g,
-                                      const vec4<Real>& h)
+                                      const history<Real>& h)
     {
-        const bool bridge = h.w >= Real(2);
-        const vec4<Real> hb{h.x, h.y, h.z, bridge ? h.w - Real(2) : h.w};
+        const bool bridge = history_base(h).w >= Real(2);
+        history<Real> hb = h;
+        history_base(hb).w -= bridge ? Real(2) : Real(0);
         const Real spring = g.delta_n < Real(0) ? Base::pair_energy(p.base, g, hb) : Real(0);
         return spring + (bridge ? bridge_energy(p, Real(2) * g.r_eff, g.delta_n) : Real(0));
     }
 
     template <class Real>
     SPHERE_HDI static Real wall_energy(const kernel_params<Real>& p, const contact_geometry<Real>& g,
-                                      const vec4<Real>& h)
+                                      const history<Real>& h)
     {
         return Base::wall_energy(p.base, g, h);
     }

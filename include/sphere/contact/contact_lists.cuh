@@ -35,6 +35,7 @@
 #include "../exec/for_each.cuh"
 #include "../exec/policy.cuh"
 #include "../grid/neighbor_grid.cuh"
+#include "history.cuh"
 
 namespace sphere {
 
@@ -59,97 +60,13 @@ struct list_totals {
     unsigned wrapped = 0;
 };
 
-/// A contact's history or recorded force as seen from its other particle: the tangential part
-/// (xyz: displacement or force) reversed, w (sliding flag, or f_n . n) kept.
-template <class Real>
-SPHERE_HDI vec4<Real> mirrored(const vec4<Real>& h)
-{
-    return {-h.x, -h.y, -h.z, h.w};
-}
-
-/// Whether an entry has a history to pass on (a contact that touched at the last step).
-template <class Real>
-SPHERE_HDI bool has_history(const vec4<Real>& h)
-{
-    return h.x != Real(0) || h.y != Real(0) || h.z != Real(0) || h.w != Real(0);
-}
-
-/// Where the contact histories live: each entry's tangential displacement (m) and its flags,
-/// in two arrays (25 B per entry in double, where one vec4 takes 32). Kernels read and write an
-/// entry as the vec4 the contact laws take: displacement in xyz, flags in w as a whole number
-/// from 0 to 255 (bit 0: sliding, the tangential laws'; bit 1: a liquid bridge,
-/// contact::capillary's).
-template <class Real>
-struct history_view {
-    vec3<Real>* shift;
-    std::uint8_t* flags;
-
-    SPHERE_HDI vec4<Real> load(std::size_t k) const
-    {
-        const vec3<Real> d = shift[k];
-        return {d.x, d.y, d.z, Real(flags[k])};
-    }
-    SPHERE_HDI void store(std::size_t k, const vec4<Real>& h) const
-    {
-        shift[k] = {h.x, h.y, h.z};
-        flags[k] = static_cast<std::uint8_t>(h.w);
-    }
-};
-
-/// The owning arrays of history_view, in a policy's memory.
-template <class Real, class Policy>
-class history_store {
-public:
-    history_store() = default;
-    /// n entries without history
-    explicit history_store(std::size_t n) : shift_(n, vec3<Real>{0, 0, 0}), flags_(n, std::uint8_t(0)) {}
-
-    std::size_t size() const { return shift_.size(); }
-    history_view<Real> view() { return {shift_.data(), flags_.data()}; }
-    /// n entries; those already there keep their values.
-    void resize(std::size_t n)
-    {
-        shift_.resize(n, vec3<Real>{0, 0, 0});
-        flags_.resize(n, std::uint8_t(0));
-    }
-    void swap(history_store& other) noexcept
-    {
-        shift_.swap(other.shift_);
-        flags_.swap(other.flags_);
-    }
-    /// A host copy, one vec4 per entry (xyz displacement, w flags).
-    std::vector<vec4<Real>> to_host() const
-    {
-        const std::vector<vec3<Real>> d = shift_.to_host();
-        const std::vector<std::uint8_t> s = flags_.to_host();
-        std::vector<vec4<Real>> out(d.size());
-        for (std::size_t k = 0; k < d.size(); ++k) out[k] = {d[k].x, d[k].y, d[k].z, Real(s[k])};
-        return out;
-    }
-    void assign(const std::vector<vec4<Real>>& h)
-    {
-        std::vector<vec3<Real>> d(h.size());
-        std::vector<std::uint8_t> s(h.size());
-        for (std::size_t k = 0; k < h.size(); ++k) {
-            d[k] = {h[k].x, h[k].y, h[k].z};
-            s[k] = h[k].w >= Real(0) && h[k].w < Real(256) ? static_cast<std::uint8_t>(h[k].w) : std::uint8_t(0);
-        }
-        shift_.assign(std::move(d));
-        flags_.assign(std::move(s));
-    }
-
-private:
-    buffer<vec3<Real>, Policy> shift_;
-    buffer<std::uint8_t, Policy> flags_;
-};
-
 /// Kernel view of the contact lists.
 template <class Real>
 struct contact_view {
     std::size_t n;                ///< particles
     const unsigned* offset;       ///< entries of rank r: [offset[r], offset[r + 1])
     const unsigned* partner;      ///< storage slot of the partner, or wall_partner_base + f (walls last)
-    history_view<Real> history;   ///< delta_t (m) seen by the owner in xyz, sliding flag in w
+    history_view<Real> history;   ///< as seen by the owner (contact/history.cuh)
     vec4<Real>* force;            ///< f_t on the owner (N) in xyz, f_n . n (N) in w; null when not recorded
     const unsigned* slot_of_rank; ///< storage slot of each rank; null when they coincide (settings.reorder)
     const unsigned* rank_of_slot; ///< the inverse; null when they coincide
@@ -165,8 +82,10 @@ template <class Real>
 struct contact_table {
     std::vector<std::size_t> offset{0};
     std::vector<unsigned> partner;
-    std::vector<vec4<Real>> history;
-    std::vector<vec4<Real>> force; ///< empty when the simulation records no contact forces
+    std::vector<vec4<Real>> history; ///< the bases: tangential displacement (m) xyz, flags w
+    history_shape shape;             ///< the law's lanes beside the base (contact/history.cuh)
+    std::vector<Real> lane;          ///< shape.lanes per entry
+    std::vector<vec4<Real>> force;   ///< empty when the simulation records no contact forces
 
     std::size_t particles() const { return offset.size() - 1; }
     std::size_t begin(std::size_t i) const { return offset[i]; }
@@ -308,13 +227,13 @@ struct old_lists {
     const unsigned* partner;
     history_view<Real> history;
 
-    /// The history of the entry of old slot `owner` for `code` (an old slot or a wall code);
-    /// false when there is none.
-    SPHERE_HD bool find(unsigned owner, unsigned code, vec4<Real>& h) const
+    /// The kept entry of old slot `owner` for `code` (an old slot or a wall code); false when
+    /// there is none.
+    SPHERE_HD bool find(unsigned owner, unsigned code, unsigned& entry) const
     {
         for (unsigned m = offset[owner]; m < offset[owner + 1]; ++m)
             if (partner[m] == code) {
-                h = history.load(m);
+                entry = m;
                 return true;
             }
         return false;
@@ -353,15 +272,18 @@ struct fill_entries {
         const unsigned me = order[k];
         for (unsigned a = 0; a < n; ++a) {
             const unsigned code = p[a];
-            vec4<Real> h{0, 0, 0, 0};
+            unsigned m = 0;
+            bool found = false, mirror = false;
             if (code >= wall_partner_base) {
-                old.find(me, code, h);
+                found = old.find(me, code, m);
             } else {
                 const unsigned them = order[code];
-                if (!old.find(me, them, h) && old.find(them, me, h)) h = mirrored(h);
+                found = old.find(me, them, m);
+                if (!found) found = mirror = old.find(them, me, m);
                 p[a] = keep_order ? them : code;
             }
-            history.store(begin + a, h);
+            if (found) history.copy(begin + a, old.history, m, mirror);
+            else history.clear(begin + a);
         }
     }
 };
@@ -374,7 +296,7 @@ struct count_histories {
     SPHERE_HD void operator()(std::size_t r) const
     {
         unsigned kept = 0;
-        for (unsigned e = c.offset[r]; e < c.offset[r + 1]; ++e) kept += has_history(c.history.load(e));
+        for (unsigned e = c.offset[r]; e < c.offset[r + 1]; ++e) kept += c.history.has(e);
         count[c.slot(r)] = kept;
     }
 };
@@ -393,10 +315,9 @@ struct copy_histories {
         if (to_offset[c.n] > capacity) return;
         unsigned k = to_offset[c.slot(r)];
         for (unsigned e = c.offset[r]; e < c.offset[r + 1]; ++e) {
-            const vec4<Real> h = c.history.load(e);
-            if (has_history(h)) {
+            if (c.history.has(e)) {
                 to_partner[k] = c.partner[e];
-                to_history.store(k, h);
+                to_history.copy(k, c.history, e, false);
                 ++k;
             }
         }
@@ -492,10 +413,11 @@ public:
     using Coord = coord_t<P>;
 
     contact_lists() = default;
-    /// Empty lists for n particles; `record_forces` keeps each entry's force of the last step.
-    contact_lists(std::size_t n, bool record_forces)
-        : record_forces_(record_forces), offset_(n + 1, 0u), next_offset_(n + 1, 0u), kept_offset_(n + 1, 0u),
-          wall_ranks_(n, no_rank)
+    /// Empty lists for n particles whose histories have `shape` (the contact law's,
+    /// contact/history.cuh); `record_forces` keeps each entry's force of the last step.
+    contact_lists(std::size_t n, bool record_forces, history_shape shape = {})
+        : record_forces_(record_forces), offset_(n + 1, 0u), next_offset_(n + 1, 0u), history_(shape),
+          kept_offset_(n + 1, 0u), kept_history_(shape), wall_ranks_(n, no_rank)
     {
     }
 
@@ -622,6 +544,8 @@ public:
         const std::size_t n = size();
         const std::vector<unsigned> off = offset_.to_host(), part = partner_.to_host();
         const std::vector<vec4<Real>> hist = history_.to_host();
+        const std::vector<Real> lanes = history_.lanes_to_host();
+        const history_shape shape = history_.shape();
         std::vector<vec4<Real>> frc;
         if (record_forces_) frc = force_.to_host();
         const std::vector<unsigned> slots = keep_order_ ? slot_of_rank_.to_host() : std::vector<unsigned>{};
@@ -652,11 +576,17 @@ public:
         for (std::size_t i = 0; i < n; ++i) t.offset[i + 1] += t.offset[i];
         t.partner.reserve(items.size());
         t.history.reserve(items.size());
+        t.shape = shape;
+        t.lane.reserve(items.size() * shape.lanes);
         if (record_forces_) t.force.reserve(items.size());
         for (const item& it : items) {
             t.partner.push_back(it.partner);
             const vec4<Real> h = hist[it.entry];
             t.history.push_back(vec_cast<Coord>(it.mirrored ? mirrored(h) : h));
+            for (unsigned l = 0; l < shape.lanes; ++l) {
+                const Real v = lanes[it.entry * shape.lanes + l];
+                t.lane.push_back(Coord(it.mirrored && (shape.mirror >> l & 1u) ? -v : v));
+            }
             if (record_forces_) {
                 const vec4<Real> f = frc[it.entry];
                 t.force.push_back(vec_cast<Coord>(it.mirrored ? mirrored(f) : f));
@@ -673,8 +603,12 @@ public:
     void restore(const contact_table<Coord>& t, const grid_view<Coord>& grid, bool keep_order)
     {
         const std::size_t n = size();
+        const history_shape shape = history_.shape();
         if (t.particles() != n || t.partner.size() != t.offset[n] || t.history.size() != t.partner.size())
             detail::fail("contact lists: the restored table does not fit ", n, " particles");
+        if (t.shape.lanes != shape.lanes || t.lane.size() != t.partner.size() * shape.lanes)
+            detail::fail("contact lists: the restored table's histories have ", t.shape.lanes,
+                         " lanes beside the base, the contact law's have ", shape.lanes);
         const std::vector<unsigned> user_of_rank = buffer_copy(grid.order, n);
         const std::vector<vec4<Coord>> x = buffer_copy(grid.sorted_x, n);
         std::vector<unsigned> rank_of_user(n);
@@ -689,15 +623,21 @@ public:
         };
         std::vector<unsigned> off(n + 1, 0), part;
         std::vector<vec4<Real>> hist;
+        std::vector<Real> lanes;
+        // the table's entry e as the lists store it: its base, then its lanes
+        auto take = [&](std::size_t e) {
+            hist.push_back(vec_cast<Real>(t.history[e]));
+            for (unsigned l = 0; l < shape.lanes; ++l) lanes.push_back(Real(t.lane[e * shape.lanes + l]));
+        };
         for (std::size_t r = 0; r < n; ++r) {
             const unsigned i = user_of_rank[r];
-            std::vector<std::pair<unsigned, vec4<Real>>> row, walls; // (partner rank or wall code, history)
+            std::vector<std::pair<unsigned, std::size_t>> row, walls; // (partner rank or wall code, table entry)
             for (std::size_t e = t.begin(i); e < t.end(i); ++e) {
                 const unsigned j = t.partner[e];
                 if (j >= wall_partner_base) {
                     if (j >= wall_partner_base + unsigned(wall_set<Coord>::count))
                         detail::fail("contact lists: particle ", i, " lists wall code ", j, ", not a wall face");
-                    walls.emplace_back(j, vec_cast<Real>(t.history[e]));
+                    walls.emplace_back(j, e);
                     continue;
                 }
                 if (j >= n) detail::fail("contact lists: particle ", i, " lists partner ", j, ", but there are ", n, " particles");
@@ -707,17 +647,17 @@ public:
                 if (!owns(unsigned(r), q) && !owns(q, unsigned(r)))
                     detail::fail("contact lists: particle ", i, " lists partner ", j,
                                  ", but their positions at the last rebuild lie more than one grid layer apart");
-                if (owns(unsigned(r), q)) row.emplace_back(q, vec_cast<Real>(t.history[e]));
+                if (owns(unsigned(r), q)) row.emplace_back(q, e);
             }
             std::sort(row.begin(), row.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
             std::sort(walls.begin(), walls.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-            for (const auto& [q, h] : row) {
+            for (const auto& [q, e] : row) {
                 part.push_back(keep_order ? user_of_rank[q] : q);
-                hist.push_back(h);
+                take(e);
             }
-            for (const auto& [code, h] : walls) {
+            for (const auto& [code, e] : walls) {
                 part.push_back(code);
-                hist.push_back(h);
+                take(e);
             }
             off[r + 1] = static_cast<unsigned>(part.size());
         }
@@ -727,7 +667,7 @@ public:
             if (off[r + 1] > off[r] && part[off[r + 1] - 1] >= wall_partner_base) wall_ranks[with_walls++] = unsigned(r);
         offset_.assign(off);
         partner_.assign(part);
-        history_.assign(hist);
+        history_.assign(hist, lanes);
         wall_ranks_.assign(wall_ranks);
         entries_ = part.size();
         wall_particles_ = with_walls;

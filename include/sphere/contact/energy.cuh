@@ -89,8 +89,9 @@ struct particle_energy {
                 g.m_i = p.mass[i];
                 g.m_j = p.mass[j];
                 g.m_eff = g.m_i * g.m_j / (g.m_i + g.m_j);
-                if (acts_apart<Law>::value || g.delta_n < Real(0))
-                    e.elastic += Coord(Law::pair_energy(pair_params, g, c.history.load(k)));
+                law_history_t<Law, Real> h;
+                c.history.load(k, h);
+                if (acts_apart<Law>::value || g.delta_n < Real(0)) e.elastic += Coord(Law::pair_energy(pair_params, g, h));
             } else {
                 const int f = static_cast<int>(j - wall_partner_base);
                 const int a = f / 2;
@@ -101,7 +102,9 @@ struct particle_energy {
                 g.r_j = Real(0);
                 g.m_i = g.m_eff = p.mass[i];
                 g.m_j = Real(0);
-                if (g.delta_n < Real(0)) e.elastic += Coord(Law::wall_energy(wall_params, g, c.history.load(k)));
+                law_history_t<Law, Real> h;
+                c.history.load(k, h);
+                if (g.delta_n < Real(0)) e.elastic += Coord(Law::wall_energy(wall_params, g, h));
             }
         }
         if (p.e_visc) { // the energy audit is on

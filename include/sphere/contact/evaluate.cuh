@@ -82,6 +82,7 @@ struct pair_contact {
     world<Coord> box;
     typename Law::template kernel_params<Real> params;
     Real dt;
+    using history_type = law_history_t<Law, Real>;
 
     /// Whether the law acts on a pair at squared distance dist2 (m^2) whose radii sum to reach
     /// (m): distinct centres that overlap, or for a law that acts apart (contact/law.cuh) lie
@@ -99,7 +100,7 @@ struct pair_contact {
     /// non-finite intermediates, which are discarded); otherwise non-touching pairs return
     /// early.
     template <bool Branchless>
-    SPHERE_HDI pair_result<Real> evaluate(std::size_t i, std::size_t j, vec4<Real>& h) const
+    SPHERE_HDI pair_result<Real> evaluate(std::size_t i, std::size_t j, history_type& h) const
     {
         const vec4<Coord> xi = p.x[i], xj = p.x[j];
         vec3<Coord> d = box.nearest_image_inside(xi.xyz() - xj.xyz());
@@ -107,7 +108,7 @@ struct pair_contact {
         const bool touching = acts(dist2, reach);
         if constexpr (!Branchless) {
             if (!touching) {
-                h = vec4<Real>{0, 0, 0, 0}; // a contact that has ended forgets its history
+                h = history_type{}; // a contact that has ended forgets its history
                 return {};
             }
         }
@@ -128,13 +129,15 @@ struct pair_contact {
                              : (p.v[i] - p.v[j]) * dt + arm_i * cross(n, p.omega[i] * dt) +
                                    arm_j * cross(n, p.omega[j] * dt);
         m.m_eff = mi * mj / (mi + mj);
-        vec4<Real> updated = h;
+        m.spin = p.omega_sync[i] - p.omega_sync[j];
+        m.spin_step = OneVelocity ? m.spin * dt : (p.omega[i] - p.omega[j]) * dt;
+        history_type updated = h;
         contact_result<Real> c = Law::pair(params, m, updated, dt);
         vec3<Real> lever = cross(n, c.tangential);
         pair_result<Real> r;
         r.force = c.normal + c.tangential;
-        r.torque_i = -arm_i * lever;
-        r.torque_j = -arm_j * lever;
+        r.torque_i = c.couple - arm_i * lever;
+        r.torque_j = -c.couple - arm_j * lever;
         r.fn = c.fn;
         r.visc_rate = c.visc_rate;
         r.fric_rate = c.fric_rate;
@@ -148,7 +151,7 @@ struct pair_contact {
             r.visc_rate = touching ? r.visc_rate : Real(0);
             r.fric_rate = touching ? r.fric_rate : Real(0);
             r.record = select(touching, r.record, vec4<Real>{0, 0, 0, 0});
-            updated = select(touching, updated, vec4<Real>{0, 0, 0, 0});
+            updated = select(touching, updated, history_type{});
         }
         h = updated;
         return r;
@@ -200,7 +203,8 @@ struct wall_contacts {
             const vec3<Real> n = wall_set<Real>::inward_normal(f);
             const Coord dist_c = (component(xi.xyz(), a) - Coord(position)) * Coord(component(n, a));
             const Real dist = Real(dist_c), delta_n = Real(dist_c - xi.w);
-            vec4<Real> h = c.history.load(k);
+            law_history_t<Law, Real> h;
+            c.history.load(k, h);
             if (delta_n < Real(0)) {
                 contact_motion<Real> m;
                 m.n = n;
@@ -211,6 +215,8 @@ struct wall_contacts {
                 m.m_j = Real(0);
                 m.velocity = vi + dist * cross(n, wi);
                 m.step = si + dist * cross(n, ti);
+                m.spin = wi;
+                m.spin_step = OneVelocity ? wi * dt : ti;
                 m.velocity -= along_axis(a, Real(wall_velocity)); // 0 subtracted on the other axes
                 if (OneVelocity) m.step = m.velocity * dt;
                 else m.step -= along_axis(a, Real(wall_velocity) * dt);
@@ -219,7 +225,7 @@ struct wall_contacts {
                 SPHERE_UNROLL
                 for (int g = 0; g < wall_set<Coord>::count; ++g) loads.force[g] = g == f ? load : loads.force[g];
                 force += r.normal + r.tangential;
-                torque -= dist * cross(n, r.tangential);
+                torque += r.couple - dist * cross(n, r.tangential);
                 if (Book) {
                     fn_sum += r.fn;
                     visc += r.visc_rate;
@@ -227,7 +233,7 @@ struct wall_contacts {
                 }
                 if (Record) c.force[k] = {r.tangential.x, r.tangential.y, r.tangential.z, dot(r.normal, n)};
             } else {
-                h = vec4<Real>{0, 0, 0, 0}; // a contact that has ended forgets its history
+                h = law_history_t<Law, Real>{}; // a contact that has ended forgets its history
                 if (Record) c.force[k] = vec4<Real>{0, 0, 0, 0};
             }
             if (update_history) c.history.store(k, h);

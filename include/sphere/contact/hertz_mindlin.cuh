@@ -274,16 +274,13 @@ private:
     template <class Real>
     static void check(const hertz_params<Real>& p, const char* where)
     {
-        if (!(p.youngs_modulus > 0) || !std::isfinite(p.youngs_modulus))
-            detail::fail(where, ".youngs_modulus = ", p.youngs_modulus, " Pa: must be positive and finite");
+        detail::require_positive(where, "youngs_modulus", p.youngs_modulus, "Pa");
         if (!(p.poisson_ratio > -1 && p.poisson_ratio <= Real(0.5)))
             detail::fail(where, ".poisson_ratio = ", p.poisson_ratio, ": must lie in (-1, 0.5]");
         if (!(p.restitution > 0 && p.restitution <= 1))
             detail::fail(where, ".restitution = ", p.restitution, ": must lie in (0, 1]");
-        if (!(p.mu_s >= 0) || !std::isfinite(p.mu_s))
-            detail::fail(where, ".mu_s = ", p.mu_s, " (friction): must be non-negative and finite");
-        if (!(p.mu_d >= 0) || !std::isfinite(p.mu_d))
-            detail::fail(where, ".mu_d = ", p.mu_d, " (friction): must be non-negative and finite");
+        detail::require_non_negative(where, "mu_s", p.mu_s, "(friction)");
+        detail::require_non_negative(where, "mu_d", p.mu_d, "(friction)");
         if (p.mu_d > p.mu_s)
             detail::fail(where, ".mu_d = ", p.mu_d, " exceeds ", where, ".mu_s = ", p.mu_s,
                          ": dynamic friction must not exceed static friction");

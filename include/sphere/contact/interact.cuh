@@ -46,8 +46,9 @@ struct zero_pair_sums {
 };
 
 /// A tile of pair contacts evaluated together in SIMD lanes: lanes [0, count) hold pairs,
-/// the rest repeat lane 0 and are discarded.
-template <class Real>
+/// the rest repeat lane 0 and are discarded. `Lanes`: the contact law's history lanes
+/// (contact/history.cuh).
+template <class Real, unsigned Lanes>
 struct pair_tile {
     static constexpr int width = 16;
     int count = 0;
@@ -55,6 +56,7 @@ struct pair_tile {
     Real fx[width], fy[width], fz[width];
     Real tix[width], tiy[width], tiz[width], tjx[width], tjy[width], tjz[width];
     Real hx[width], hy[width], hz[width], hw[width];
+    Real hl[Lanes > 0 ? Lanes : 1][width];
     Real fn[width], visc[width], fric[width];
     Real rx[width], ry[width], rz[width], rw[width];
 };
@@ -71,8 +73,8 @@ struct slab_pairs {
 
     void operator()(unsigned first_rank, unsigned end_rank) const
     {
-        pair_tile<Real> t;
-        unsigned apart[pair_tile<Real>::width]; // entries of pairs that do not touch
+        tile t;
+        unsigned apart[tile::width]; // entries of pairs that do not touch
         int apart_count = 0;
         const particle_view<P>& p = eval.p;
         for (unsigned r = first_rank; r < end_rank; ++r) {
@@ -98,11 +100,11 @@ struct slab_pairs {
                     apart[apart_count] = e;
                     t.count += touching;
                     apart_count += !touching;
-                    if (apart_count == pair_tile<Real>::width) forget(apart, apart_count);
+                    if (apart_count == tile::width) forget(apart, apart_count);
                 } else {
                     ++t.count;
                 }
-                if (t.count == pair_tile<Real>::width) flush(t);
+                if (t.count == tile::width) flush(t);
             }
         }
         if (t.count) flush(t);
@@ -111,6 +113,9 @@ struct slab_pairs {
 
 private:
     using Coord = coord_t<P>;
+    using history_type = law_history_t<Law, Real>;
+    static constexpr unsigned lanes = law_history_shape<Law>::value.lanes;
+    using tile = pair_tile<Real, lanes>;
 
     /// Whether pairs that do not touch are sorted out before the SIMD tiles (where they would
     /// take a lane and add zeros to both particles): 7% faster on the dense bed in double and
@@ -122,15 +127,15 @@ private:
     void forget(const unsigned* entry, int& count) const
     {
         for (int k = 0; k < count; ++k) {
-            if (update_history) c.history.store(entry[k], vec4<Real>{0, 0, 0, 0});
+            if (update_history) c.history.clear(entry[k]);
             if (Record) c.force[entry[k]] = vec4<Real>{0, 0, 0, 0};
         }
         count = 0;
     }
 
-    void flush(pair_tile<Real>& t) const
+    void flush(tile& t) const
     {
-        constexpr int w = pair_tile<Real>::width;
+        constexpr int w = tile::width;
         for (int k = t.count; k < w; ++k) {
             t.owner[k] = t.owner[0];
             t.partner[k] = t.partner[0];
@@ -140,10 +145,14 @@ private:
         // Local copies: loop invariants the compiler can keep in registers.
         pair_contact<P, Law, OneVelocity> pairs = eval;
         const vec3<Real>* shift = c.history.shift;
+        const Real* lane = c.history.lane;
         SPHERE_VECTORISE_LOOP
         for (int k = 0; k < w; ++k) {
             const vec3<Real> d = shift[t.entry[k]];
-            vec4<Real> h{d.x, d.y, d.z, t.hw[k]};
+            history_type h;
+            history_base(h) = {d.x, d.y, d.z, t.hw[k]};
+            if constexpr (lanes > 0)
+                for (unsigned l = 0; l < lanes; ++l) h.lane[l] = lane[t.entry[k] * lanes + l];
             pair_result<Real> r = pairs.template evaluate<true>(t.owner[k], t.partner[k], h);
             t.fx[k] = r.force.x;
             t.fy[k] = r.force.y;
@@ -154,10 +163,13 @@ private:
             t.tjx[k] = r.torque_j.x;
             t.tjy[k] = r.torque_j.y;
             t.tjz[k] = r.torque_j.z;
-            t.hx[k] = h.x;
-            t.hy[k] = h.y;
-            t.hz[k] = h.z;
-            t.hw[k] = h.w;
+            const vec4<Real>& hb = history_base(h);
+            t.hx[k] = hb.x;
+            t.hy[k] = hb.y;
+            t.hz[k] = hb.z;
+            t.hw[k] = hb.w;
+            if constexpr (lanes > 0)
+                for (unsigned l = 0; l < lanes; ++l) t.hl[l][k] = h.lane[l];
             if (Book) {
                 t.fn[k] = r.fn;
                 t.visc[k] = r.visc_rate / 2;
@@ -173,7 +185,11 @@ private:
         const particle_view<P>& p = eval.p;
         for (int k = 0; k < t.count; ++k) {
             const unsigned i = t.owner[k], j = t.partner[k], e = t.entry[k];
-            if (update_history) c.history.store(e, {t.hx[k], t.hy[k], t.hz[k], t.hw[k]});
+            if (update_history) {
+                c.history.set_base(e, {t.hx[k], t.hy[k], t.hz[k], t.hw[k]});
+                if constexpr (lanes > 0)
+                    for (unsigned l = 0; l < lanes; ++l) c.history.lane[e * lanes + l] = t.hl[l][k];
+            }
             if (Record) c.force[e] = {t.rx[k], t.ry[k], t.rz[k], t.rw[k]};
             const vec3<Real> f{t.fx[k], t.fy[k], t.fz[k]};
             p.force[i] += f;
@@ -318,7 +334,8 @@ struct evaluate_owned_pairs {
         for (unsigned e = c.offset[r]; e < end; ++e) {
             const unsigned j = c.partner[e];
             if (j >= wall_partner_base) break;
-            vec4<Real> h = c.history.load(e);
+            law_history_t<Law, Real> h;
+            c.history.load(e, h);
             pair_result<Real> res = eval.template evaluate<false>(i, j, h);
             if (update_history) c.history.store(e, h);
             if (Record) c.force[e] = res.record;

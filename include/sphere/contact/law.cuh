@@ -19,12 +19,15 @@
 ///     static Real time_scale(const params<Real>& pair, const params<Real>& wall, Real mass, Real radius);
 ///     template <class Real>   // what time_scale used, for an error message
 ///     static std::string time_scale_inputs(const params<Real>& pair, const params<Real>& wall, Real mass, Real radius);
-///     template <class Real>   // a pair contact (a wall contact): forces and dissipation rates
+///     template <class Real>   // a pair contact (a wall contact): forces, a couple and dissipation rates
 ///     SPHERE_HDI static contact_result<Real> pair(const kernel_params<Real>&, const contact_motion<Real>&,
-///                                                vec4<Real>& history, Real dt);        // and wall(...)
+///                                                H& history, Real dt);                // and wall(...)
 ///     template <class Real>   // the elastic energy stored in a contact (J)
 ///     SPHERE_HDI static Real pair_energy(const kernel_params<Real>&, const contact_geometry<Real>&,
-///                                       const vec4<Real>& history);                   // and wall_energy(...)
+///                                       const H& history);                           // and wall_energy(...)
+///
+/// with H = law_history_t<Law, Real>: a vec4 (tangential displacement xyz, flags w), or for a
+/// law that declares history_lanes a contact_history with its own lanes (contact/history.cuh).
 ///
 /// Each params type P has `template <class Self, class F> static void fields(Self&, F&&)`,
 /// calling f(name, field, unit) for every field (a floating value, a bool or an enumeration
@@ -38,17 +41,30 @@
 ///
 /// and then receives pairs with 0 <= delta_n < range too; pair_energy likewise. The contact
 /// lists reach that much further. Walls see contacts only (delta_n < 0).
-///
-/// The history of a contact is, for every law so far, the tangential displacement (xyz, m)
-/// and whole-number flags (w, 0 to 255): the contact lists store it as such
-/// (contact/contact_lists.cuh).
+#include <cmath>
 #include <sstream>
 #include <string>
 #include <type_traits>
 
 #include "../core/config.cuh"
+#include "../core/error.cuh"
 
 namespace sphere {
+
+namespace detail {
+/// Refuses a law's parameter `where`.`name` = v (with its unit) unless it is positive and finite.
+template <class Real>
+void require_positive(const char* where, const char* name, Real v, const char* unit)
+{
+    if (!(v > 0) || !std::isfinite(v)) fail(where, ".", name, " = ", v, " ", unit, ": must be positive and finite");
+}
+/// Refuses a law's parameter unless it is non-negative and finite.
+template <class Real>
+void require_non_negative(const char* where, const char* name, Real v, const char* unit)
+{
+    if (!(v >= 0) || !std::isfinite(v)) fail(where, ".", name, " = ", v, " ", unit, ": must be non-negative and finite");
+}
+} // namespace detail
 
 /// Whether Law acts between particles that do not touch (Law::acts_apart).
 template <class Law, class = void>

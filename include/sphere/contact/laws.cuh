@@ -5,3 +5,4 @@
 #include "capillary.cuh"
 #include "hertz_mindlin.cuh"
 #include "linear.cuh"
+#include "rolling.cuh"

@@ -172,12 +172,9 @@ private:
     template <class Real>
     static void check(const contact_params<Real>& p, const char* where)
     {
-        auto positive = [&](Real v, const char* name, const char* unit) {
-            if (!(v > 0) || !std::isfinite(v)) detail::fail(where, ".", name, " = ", v, " ", unit, ": must be positive and finite");
-        };
+        auto positive = [&](Real v, const char* name, const char* unit) { detail::require_positive(where, name, v, unit); };
         auto non_negative = [&](Real v, const char* name, const char* unit) {
-            if (!(v >= 0) || !std::isfinite(v))
-                detail::fail(where, ".", name, " = ", v, " ", unit, ": must be non-negative and finite");
+            detail::require_non_negative(where, name, v, unit);
         };
         positive(p.k_n, "k_n", "N/m");
         non_negative(p.k_t, "k_t", "N/m");

@@ -24,6 +24,10 @@ struct contact_motion : contact_geometry<Real> {
                          ///< at the time of the positions (m/s): drives the dashpots
     vec3<Real> step;     ///< displacement of the contact point relative to the partner's during
                          ///< the step that led to the positions (m): drives the tangential spring
+    vec3<Real> spin;      ///< angular velocity of this particle less the partner's (rad/s, a wall's is 0),
+                          ///< at the time of the positions
+    vec3<Real> spin_step; ///< rotation of this particle relative to the partner during the step that
+                          ///< led to the positions (rad, a rotation vector)
 };
 
 /// One evaluated contact, as seen by the particle it acts on.
@@ -31,6 +35,8 @@ template <class Real>
 struct contact_result {
     vec3<Real> normal{0, 0, 0};     ///< f_n (N)
     vec3<Real> tangential{0, 0, 0}; ///< f_t (N)
+    vec3<Real> couple{0, 0, 0};     ///< a torque on this particle beside that of f_t (N m), e.g. rolling
+                                    ///< resistance; the partner feels -couple
     Real fn = 0;                    ///< |f_n| (N)
     Real visc_rate = 0;             ///< viscous dissipation, normal + tangential (W)
     Real fric_rate = 0;             ///< frictional dissipation (W)

@@ -334,6 +334,10 @@ std::string encode_checkpoint(const settings<Real, typename Law::template params
     e.array(counts, put_u32);
     e.array(s.contacts.partner, put_u32);
     e.array(s.contacts.history, put_v4);
+    if (s.contacts.shape.lanes != law_history_shape<Law>::value.lanes)
+        detail::fail("checkpoint: the contact table's histories have ", s.contacts.shape.lanes,
+                     " lanes beside the base, ", Law::name(), "'s have ", law_history_shape<Law>::value.lanes);
+    if (s.contacts.shape.lanes) e.array(s.contacts.lane, put_real); // the law's own lanes (history_layout)
     e.array(s.x_at_build, put_v4);
     e.array(s.storage, put_u32);
 
@@ -478,6 +482,10 @@ checkpoint_data<Real, Law> decode_checkpoint(const std::string& bytes, const std
     for (std::size_t i = 0; i < n; ++i) t.offset[i + 1] = t.offset[i] + counts[i];
     t.partner = d.array<unsigned>("the contact partners", t.offset[n], 4, get_u32);
     t.history = d.array<vec4<Real>>("the contact histories", t.offset[n], 32, get_v4);
+    t.shape = law_history_shape<Law>::value;
+    if (t.shape.lanes)
+        t.lane = d.array<Real>("the contact histories' lanes", t.offset[n] * t.shape.lanes, 8,
+                               [](checkpoint_decoder& in) { return Real(in.f64("a history lane")); });
     st.x_at_build = d.array<vec4<Real>>("the positions at the last rebuild", n, 32, get_v4);
     st.storage = d.array<unsigned>("the storage order", n, 4, get_u32);
     if (d.left() != 0) d.inconsistent(d.left(), " bytes follow the last array");
