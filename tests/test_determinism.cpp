@@ -148,6 +148,7 @@ std::vector<std::string> differences(const record<Real>& a, const record<Real>& 
     if (!same_bytes(sa.p_visc, sb.p_visc)) out.push_back("p_visc");
     if (!same_bytes(sa.p_fric, sb.p_fric)) out.push_back("p_fric");
     if (!same_bytes(sa.kind, sb.kind)) out.push_back("kind");
+    if (!same_bytes(sa.material, sb.material)) out.push_back("material");
     if (!same_bytes(a.contacts.offset, b.contacts.offset)) out.push_back("contact offsets");
     if (!same_bytes(a.contacts.partner, b.contacts.partner)) out.push_back("contact partners");
     if (!same_bytes(a.contacts.history, b.contacts.history)) out.push_back("contact histories");

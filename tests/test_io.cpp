@@ -751,6 +751,7 @@ void check_vtu(const std::string& path, const sphere::particle_snapshot<Real>& s
     std::vector<std::string> kinds;
     for (const std::uint8_t k : s.kind) kinds.push_back(std::to_string(unsigned(k)));
     CHECK(vtk_array(xml, "kind") == kinds);
+    CHECK(vtk_array(xml, "material") == std::vector<std::string>(s.size(), "0"));
 }
 
 struct pvd_entry {

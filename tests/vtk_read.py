@@ -93,13 +93,13 @@ def check_frame(folder, precision, frame, tol, setup):
 
     data = grid.GetPointData()
     read = {}
-    for name in VECTORS + SCALARS + ["kind"]:
+    for name in VECTORS + SCALARS + ["kind", "material"]:
         array = data.GetArray(name)
         if array is None:
             fail(f"{where}: no point-data array '{name}'")
             continue
         components = 3 if name in VECTORS else 1
-        vtk_type = VTK_UNSIGNED_CHAR if name == "kind" else VTK_TYPE[precision]
+        vtk_type = VTK_UNSIGNED_CHAR if name in ("kind", "material") else VTK_TYPE[precision]
         if array.GetNumberOfComponents() != components or array.GetNumberOfTuples() != n:
             fail(f"{where}: '{name}' has {array.GetNumberOfTuples()} tuples of {array.GetNumberOfComponents()}, "
                  f"expected {n} of {components}")

@@ -86,11 +86,12 @@ std::string frame_json(const sphere::simulation<Real>& sim, const std::string& f
     const sphere::particle_snapshot<Real> s = sim.snapshot();
     std::vector<sphere::vec3<Real>> position(s.size());
     std::vector<Real> radius(s.size());
-    std::vector<unsigned> kind(s.size());
+    std::vector<unsigned> kind(s.size()), material(s.size());
     for (std::size_t i = 0; i < s.size(); ++i) {
         position[i] = s.position(i);
         radius[i] = s.radius(i);
         kind[i] = s.kind[i];
+        material[i] = s.material[i];
     }
     std::ostringstream out = json_stream();
     out << "    {\"file\": \"" << file << "\", \"step\": " << sim.steps() << ", \"time\": " << sim.time()
@@ -118,6 +119,8 @@ std::string frame_json(const sphere::simulation<Real>& sim, const std::string& f
     scalars(out, "dissipated_frictional", s.e_fric);
     out << ",\n     ";
     scalars(out, "kind", kind);
+    out << ",\n     ";
+    scalars(out, "material", material);
     out << "}";
     return out.str();
 }

@@ -231,6 +231,7 @@ public:
         validate_wall_controls(s.walls, s.box);
         if (particles.empty()) detail::fail("no particles: a simulation needs at least one");
         validate_particles(particles, s.box);
+        for (std::size_t i = 0; i < particles.size(); ++i) check_material(i, particles[i].material, "");
         check_fits_real(s);
 
         Coord max_radius = 0;
@@ -516,6 +517,9 @@ public:
                 detail::fail("restore: particle ", i, " has motion kind ", unsigned(s.particles.kind[i]), ", at most ",
                              unsigned(last_motion), " is valid");
         for (std::size_t i = 0; i < size(); ++i) kinds_[i] = static_cast<motion>(s.particles.kind[i]);
+        if (s.particles.material.size() != size())
+            detail::fail("restore: the state holds ", s.particles.material.size(), " materials for ", size(), " particles");
+        for (std::size_t i = 0; i < size(); ++i) check_material(i, s.particles.material[i], "restore: ");
         if (s.x_at_build.size() != size())
             detail::fail("restore: the state holds ", s.x_at_build.size(), " build positions for ", size(), " particles");
         for (std::size_t i = 0; i < size(); ++i)
@@ -639,6 +643,7 @@ public:
             ps.mass.push_back(sphere_mass(a.radius, a.density));
             for (auto* field : {&ps.pressure, &ps.e_visc, &ps.e_fric, &ps.p_visc, &ps.p_fric}) field->push_back(0);
             ps.kind.push_back(static_cast<std::uint8_t>(a.kind));
+            ps.material.push_back(a.material);
             st.contacts.offset.push_back(st.contacts.offset.back());
             st.x_at_build.push_back(ps.x.back());
             st.storage.push_back(static_cast<unsigned>(st.storage.size()));
@@ -912,6 +917,15 @@ private:
                 });
             for (int a = 0; a < 3; ++a) fits_real(s.gravity[a], " m/s^2", "settings.gravity[", a, "]");
         }
+    }
+
+    /// Refuses a material index that the contact law does not have (`before` prefixes the message).
+    static void check_material(std::size_t i, unsigned material, const char* before)
+    {
+        constexpr unsigned count = law_material_count<Law>::value;
+        if (material >= count)
+            detail::fail(before, "particle ", i, ": material = ", material, ", but the contact law ", Law::name(),
+                         " has materials 0 to ", count - 1, count == 1 ? " (contact::materials<Law, Count> has more)" : "");
     }
 
     /// Throws the error for particle i (a user index) at step `step`.

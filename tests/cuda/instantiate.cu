@@ -1,6 +1,6 @@
 // Instantiates every kernel of the DEM core for sphere::cuda in float, double and mixed
 // precision, with every contact-law and integrator policy (Hertz-Mindlin, capillary
-// cohesion and rolling resistance under it in double), so that CI proves the CUDA backend compiles and links, and ptxas
+// cohesion and rolling resistance under it, and two materials in double), so that CI proves the CUDA backend compiles and links, and ptxas
 // reports every kernel's resources (tests/check_ptxas.py).
 // It is built, not run: build machines have no GPU.
 #include <sphere/dem.cuh>
@@ -39,6 +39,12 @@ void stiffen(sphere::rolling_params<Real, Base>& p)
     stiffen(static_cast<Base&>(p));
     p.mu_r = p.mu_twist = Real(0.1);
     p.k_r = p.k_twist = Real(1);
+}
+
+template <class Params, unsigned Count>
+void stiffen(sphere::material_params<Params, Count>& p)
+{
+    for (Params& m : p.material) stiffen(m);
 }
 
 template <class P, class Law, class Integrator>
@@ -92,6 +98,7 @@ int main()
                                 exercise<double, sphere::contact::capillary<>, sphere::integrate::semi_implicit_euler>() +
                                 exercise<double, sphere::contact::capillary<sphere::contact::rolling<>>,
                                          sphere::integrate::velocity_verlet>() +
+                                exercise<double, sphere::contact::materials<>, sphere::integrate::semi_implicit_euler>() +
                                 exercise_step_shapes<sphere::mixed>());
     return 0;
 }

@@ -75,29 +75,52 @@ struct capillary {
     template <class Real>
     using history = law_history_t<Base, Real>;
 
-    /// Throws sphere::error naming the first bad parameter.
+    /// Throws sphere::error naming the first bad parameter (where: the settings they came from).
     template <class Real>
-    static void validate(const params<Real>& pair, const params<Real>& wall)
+    static void validate(const params<Real>& pair, const params<Real>& wall,
+                         const char* pair_where = "settings.contact", const char* wall_where = "settings.wall")
     {
-        Base::validate(pair, wall);
-        const char* where = "settings.contact";
+        Base::validate(pair, wall, pair_where, wall_where);
+        const char* where = pair_where;
         detail::require_non_negative(where, "surface_tension", pair.surface_tension, "N/m");
         if (!(pair.contact_angle >= 0 && pair.contact_angle < Real(pi<double> / 2)))
             detail::fail(where, ".contact_angle = ", pair.contact_angle, " rad: must lie in [0, pi/2)");
         detail::require_positive(where, "bridge_volume", pair.bridge_volume, "m^3");
     }
 
+    /// Particles of materials a and b with the pair's parameters `contact` (its bridges').
+    template <class Real, class From>
+    static kernel_params<Real> kernel(const params<From>& a, const params<From>& b, const params<From>& contact)
+    {
+        const double theta = double(contact.contact_angle), v = double(contact.bridge_volume);
+        return {Base::template kernel<Real>(a, b, contact),
+                Real(2 * pi<double> * double(contact.surface_tension) * std::cos(theta)), Real(v),
+                Real((1 + theta / 2) * std::cbrt(v))};
+    }
     template <class Real, class From>
     static kernel_params<Real> pair_kernel(const params<From>& pair)
     {
-        const double theta = double(pair.contact_angle), v = double(pair.bridge_volume);
-        return {Base::template pair_kernel<Real>(pair), Real(2 * pi<double> * double(pair.surface_tension) * std::cos(theta)),
-                Real(v), Real((1 + theta / 2) * std::cbrt(v))};
+        return kernel<Real>(pair, pair, pair);
     }
     template <class Real, class From>
     static kernel_params<Real> wall_kernel(const params<From>& pair, const params<From>& wall)
     {
         return {Base::template wall_kernel<Real>(pair, wall), Real(0), Real(0), Real(0)};
+    }
+
+    /// Unlike materials (docs/physics.md, "Materials"): the base law's mixing; the liquid (its
+    /// surface tension, the bridges' volume) must agree, and the contact angle is the one whose
+    /// cosine is the mean of the two cosines.
+    template <class Real>
+    static params<Real> mix(const params<Real>& a, const params<Real>& b, const char* a_where, const char* b_where)
+    {
+        detail::agree(a.surface_tension, b.surface_tension, "surface_tension", a_where, b_where);
+        detail::agree(a.bridge_volume, b.bridge_volume, "bridge_volume", a_where, b_where);
+        params<Real> out = a;
+        static_cast<typename Base::template params<Real>&>(out) = Base::mix(a, b, a_where, b_where);
+        if (a.contact_angle != b.contact_angle)
+            out.contact_angle = Real(std::acos((std::cos(double(a.contact_angle)) + std::cos(double(b.contact_angle))) / 2));
+        return out;
     }
 
     template <class Real>

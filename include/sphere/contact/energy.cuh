@@ -63,6 +63,7 @@ struct particle_energy {
     typename Law::template kernel_params<Real> pair_params;
     typename Law::template kernel_params<Real> wall_params;
     vec3<Coord> gravity;
+    static constexpr bool materials = law_material_count<Law>::value > 1;
 
     SPHERE_HD energy_budget<Coord> operator()(std::size_t i) const
     {
@@ -79,29 +80,18 @@ struct particle_energy {
                 const vec4<Coord> xj = p.x[j];
                 const vec3<Coord> d = box.nearest_image_inside(xi.xyz() - xj.xyz());
                 const Coord dist2 = norm2(d), reach = xi.w + xj.w;
-                const Coord cut = acts_apart<Law>::value ? reach + law_range<Law, Coord>(pair_params) : reach;
-                if (!(dist2 < cut * cut)) continue;
+                if (!law_acts<Law>(pair_params, dist2, reach)) continue;
                 contact_geometry<Real> g;
-                g.delta_n = overlap_and_normal(d, dist2, reach, g.n);
-                g.r_i = Real(xi.w);
-                g.r_j = Real(xj.w);
-                g.r_eff = g.r_i * g.r_j / (g.r_i + g.r_j);
-                g.m_i = p.mass[i];
-                g.m_j = p.mass[j];
-                g.m_eff = g.m_i * g.m_j / (g.m_i + g.m_j);
+                pair_geometry<materials>(g, p, i, j, d, dist2, xi.w, xj.w);
                 law_history_t<Law, Real> h;
                 c.history.load(k, h);
-                if (acts_apart<Law>::value || g.delta_n < Real(0)) e.elastic += Coord(Law::pair_energy(pair_params, g, h));
+                e.elastic += Coord(Law::pair_energy(pair_params, g, h));
             } else {
                 const int f = static_cast<int>(j - wall_partner_base);
                 const int a = f / 2;
+                const vec3<Real> n = wall_set<Real>::inward_normal(f);
                 contact_geometry<Real> g;
-                g.n = wall_set<Real>::inward_normal(f);
-                g.delta_n = Real((xi.xyz()[a] - Coord(walls.face[f].position)) * Coord(g.n[a]) - xi.w);
-                g.r_i = g.r_eff = Real(xi.w);
-                g.r_j = Real(0);
-                g.m_i = g.m_eff = p.mass[i];
-                g.m_j = Real(0);
+                wall_geometry<materials>(g, p, i, f, n, Real((xi.xyz()[a] - Coord(walls.face[f].position)) * Coord(n[a]) - xi.w));
                 law_history_t<Law, Real> h;
                 c.history.load(k, h);
                 if (g.delta_n < Real(0)) e.elastic += Coord(Law::wall_energy(wall_params, g, h));

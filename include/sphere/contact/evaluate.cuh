@@ -60,6 +60,52 @@ SPHERE_HDI Real overlap_and_normal(const vec3<Coord>& d, Coord dist2, Coord reac
     }
 }
 
+/// Whether Law with kernel parameters `params` acts on a pair at squared distance dist2 (m^2)
+/// whose radii sum to reach (m): distinct centres that overlap, or for a law that acts apart
+/// (contact/law.cuh) lie within its range of touching.
+template <class Law, class KernelParams, class Coord>
+SPHERE_HDI bool law_acts(const KernelParams& params, Coord dist2, Coord reach)
+{
+    const Coord cut = acts_apart<Law>::value ? reach + law_range<Law, Coord>(params) : reach;
+    return dist2 < cut * cut && dist2 > Coord(0);
+}
+
+/// Fills the geometry g of the contact of particles i and j of p, as seen by i, from their
+/// separation d (m), its squared length dist2 and their radii; with `Materials` (a law that
+/// tells materials apart, contact/law.cuh) their material indices too, else 0.
+template <bool Materials, class P, class Coord>
+SPHERE_HDI void pair_geometry(contact_geometry<real_t<P>>& g, const particle_view<P>& p, std::size_t i, std::size_t j,
+                              const vec3<Coord>& d, Coord dist2, Coord r_i, Coord r_j)
+{
+    using Real = real_t<P>;
+    g.delta_n = overlap_and_normal(d, dist2, r_i + r_j, g.n);
+    g.r_i = Real(r_i);
+    g.r_j = Real(r_j);
+    g.r_eff = g.r_i * g.r_j / (g.r_i + g.r_j);
+    g.m_i = p.mass[i];
+    g.m_j = p.mass[j];
+    g.m_eff = g.m_i * g.m_j / (g.m_i + g.m_j);
+    g.material_i = Materials ? p.material[i] : 0u;
+    g.material_j = Materials ? p.material[j] : 0u;
+}
+
+/// Fills the geometry g of particle i's contact with wall face f (unit normal n into the
+/// world, overlap delta_n, m) as seen by i: the wall has r_j = m_j = 0, and material_j = f.
+template <bool Materials, class P>
+SPHERE_HDI void wall_geometry(contact_geometry<real_t<P>>& g, const particle_view<P>& p, std::size_t i, int f,
+                              const vec3<real_t<P>>& n, real_t<P> delta_n)
+{
+    using Real = real_t<P>;
+    g.n = n;
+    g.delta_n = delta_n;
+    g.r_i = g.r_eff = Real(p.x[i].w);
+    g.r_j = Real(0);
+    g.m_i = g.m_eff = p.mass[i];
+    g.m_j = Real(0);
+    g.material_i = Materials ? p.material[i] : 0u;
+    g.material_j = static_cast<unsigned>(f);
+}
+
 /// One evaluated pair contact, for its owner i and its partner j.
 template <class Real>
 struct pair_result {
@@ -83,14 +129,14 @@ struct pair_contact {
     typename Law::template kernel_params<Real> params;
     Real dt;
     using history_type = law_history_t<Law, Real>;
+    static constexpr bool materials = law_material_count<Law>::value > 1;
 
     /// Whether the law acts on a pair at squared distance dist2 (m^2) whose radii sum to reach
     /// (m): distinct centres that overlap, or for a law that acts apart (contact/law.cuh) lie
     /// within its range of touching.
     SPHERE_HDI bool acts(Coord dist2, Coord reach) const
     {
-        const Coord cut = acts_apart<Law>::value ? reach + law_range<Law, Coord>(params) : reach;
-        return dist2 < cut * cut && dist2 > Coord(0);
+        return law_acts<Law>(params, dist2, reach);
     }
 
     /// The contact of i (owner) and j (slots) with history h (updated): both particles'
@@ -112,23 +158,14 @@ struct pair_contact {
                 return {};
             }
         }
-        vec3<Real> n;
-        const Real delta_n = overlap_and_normal(d, dist2, reach, n);
-        const Real arm_i = Real(xi.w) + delta_n / 2, arm_j = Real(xj.w) + delta_n / 2;
-        const Real mi = p.mass[i], mj = p.mass[j];
         contact_motion<Real> m;
-        m.n = n;
-        m.delta_n = delta_n;
-        m.r_i = Real(xi.w);
-        m.r_j = Real(xj.w);
-        m.r_eff = m.r_i * m.r_j / (m.r_i + m.r_j);
-        m.m_i = mi;
-        m.m_j = mj;
+        pair_geometry<materials>(m, p, i, j, d, dist2, xi.w, xj.w);
+        vec3<Real> n = m.n; // not const: see the note at the top
+        const Real arm_i = Real(xi.w) + m.delta_n / 2, arm_j = Real(xj.w) + m.delta_n / 2;
         m.velocity = p.v_sync[i] - p.v_sync[j] + arm_i * cross(n, p.omega_sync[i]) + arm_j * cross(n, p.omega_sync[j]);
         m.step = OneVelocity ? m.velocity * dt
                              : (p.v[i] - p.v[j]) * dt + arm_i * cross(n, p.omega[i] * dt) +
                                    arm_j * cross(n, p.omega[j] * dt);
-        m.m_eff = mi * mj / (mi + mj);
         m.spin = p.omega_sync[i] - p.omega_sync[j];
         m.spin_step = OneVelocity ? m.spin * dt : (p.omega[i] - p.omega[j]) * dt;
         history_type updated = h;
@@ -174,6 +211,7 @@ struct wall_contacts {
     typename Law::template kernel_params<Real> params;
     Real dt;
     bool update_history; ///< false for a force evaluation that must leave the contacts as they are
+    static constexpr bool materials = law_material_count<Law>::value > 1;
 
     SPHERE_HD wall_loads operator()(std::size_t k) const
     {
@@ -207,12 +245,7 @@ struct wall_contacts {
             c.history.load(k, h);
             if (delta_n < Real(0)) {
                 contact_motion<Real> m;
-                m.n = n;
-                m.delta_n = delta_n;
-                m.r_i = m.r_eff = Real(xi.w);
-                m.r_j = Real(0);
-                m.m_i = m.m_eff = p.mass[i];
-                m.m_j = Real(0);
+                wall_geometry<materials>(m, p, i, f, n, delta_n);
                 m.velocity = vi + dist * cross(n, wi);
                 m.step = si + dist * cross(n, ti);
                 m.spin = wi;

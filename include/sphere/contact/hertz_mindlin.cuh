@@ -127,12 +127,28 @@ struct hertz_mindlin {
     /// particle material (docs/physics.md, "Time step").
     static constexpr time_step_rule time_step{0.2, 0.5, "T_R"};
 
-    /// Throws sphere::error naming the first bad parameter.
+    /// Throws sphere::error naming the first bad parameter (where: the settings they came from).
     template <class Real>
-    static void validate(const hertz_params<Real>& pair, const hertz_params<Real>& wall)
+    static void validate(const hertz_params<Real>& pair, const hertz_params<Real>& wall,
+                         const char* pair_where = "settings.contact", const char* wall_where = "settings.wall")
     {
-        check(pair, "settings.contact");
-        check(wall, "settings.wall");
+        check(pair, pair_where);
+        check(wall, wall_where);
+    }
+
+    /// A contact of materials a and b (E and nu of each) with the restitution and friction of
+    /// `contact`: 1/E* = (1 - nu_a^2)/E_a + (1 - nu_b^2)/E_b, 1/G* = (2 - nu_a)/G_a + (2 - nu_b)/G_b.
+    template <class Real, class From>
+    static hertz_contact<Real> kernel(const hertz_params<From>& a, const hertz_params<From>& b,
+                                      const hertz_params<From>& contact)
+    {
+        const double ea = double(a.youngs_modulus), na = double(a.poisson_ratio);
+        const double eb = double(b.youngs_modulus), nb = double(b.poisson_ratio);
+        const double ga = ea / (2 * (1 + na)), gb = eb / (2 * (1 + nb));
+        const double e_star = 1 / ((1 - na * na) / ea + (1 - nb * nb) / eb);
+        const double g_star = 1 / ((2 - na) / ga + (2 - nb) / gb);
+        const double alpha = hertz_damping_from_restitution(double(contact.restitution), contact.tension);
+        return {Real(e_star), Real(g_star), Real(alpha), Real(contact.mu_s), Real(contact.mu_d), contact.tension};
     }
 
     /// Two particles of the material: E* = E / (2 (1 - nu^2)), G* = G / (2 (2 - nu)).
@@ -147,6 +163,21 @@ struct hertz_mindlin {
     static hertz_contact<Real> wall_kernel(const hertz_params<From>& pair, const hertz_params<From>& wall)
     {
         return kernel<Real>(pair, wall, wall);
+    }
+
+    /// The contact parameters of unlike materials a and b (docs/physics.md, "Materials"): the
+    /// restitution and the friction coefficients by their geometric mean (E and nu stay each
+    /// material's: kernel mixes them); tension must agree.
+    template <class Real>
+    static hertz_params<Real> mix(const hertz_params<Real>& a, const hertz_params<Real>& b, const char* a_where,
+                                  const char* b_where)
+    {
+        detail::agree(a.tension, b.tension, "tension", a_where, b_where);
+        hertz_params<Real> out = a;
+        out.restitution = detail::geometric_mean(a.restitution, b.restitution);
+        out.mu_s = detail::geometric_mean(a.mu_s, b.mu_s);
+        out.mu_d = detail::geometric_mean(a.mu_d, b.mu_d);
+        return out;
     }
 
     /// The Rayleigh time of a particle of the pairs' material (s).
@@ -196,19 +227,6 @@ struct hertz_mindlin {
     }
 
 private:
-    template <class Real, class From>
-    static hertz_contact<Real> kernel(const hertz_params<From>& a, const hertz_params<From>& b,
-                                      const hertz_params<From>& contact)
-    {
-        const double ea = double(a.youngs_modulus), na = double(a.poisson_ratio);
-        const double eb = double(b.youngs_modulus), nb = double(b.poisson_ratio);
-        const double ga = ea / (2 * (1 + na)), gb = eb / (2 * (1 + nb));
-        const double e_star = 1 / ((1 - na * na) / ea + (1 - nb * nb) / eb);
-        const double g_star = 1 / ((2 - na) / ga + (2 - nb) / gb);
-        const double alpha = hertz_damping_from_restitution(double(contact.restitution), contact.tension);
-        return {Real(e_star), Real(g_star), Real(alpha), Real(contact.mu_s), Real(contact.mu_d), contact.tension};
-    }
-
     /// The stiffnesses at overlap delta (> 0): k_n with k_n delta the elastic normal force, and
     /// S_n, S_t (N/m).
     template <class Real>

@@ -64,7 +64,38 @@ void require_non_negative(const char* where, const char* name, Real v, const cha
 {
     if (!(v >= 0) || !std::isfinite(v)) fail(where, ".", name, " = ", v, " ", unit, ": must be non-negative and finite");
 }
+
+/// Mixing rules for the contact parameters of unlike materials (docs/physics.md, "Materials");
+/// each gives a itself when a == b, so a pair of like materials keeps its parameters exactly.
+/// Two springs or dashpots in series, each of half the contact: 2 a b / (a + b).
+template <class Real>
+Real series(Real a, Real b)
+{
+    return a == b ? a : 2 * a * b / (a + b);
+}
+/// sqrt(a b), for dimensionless coefficients (friction, restitution).
+template <class Real>
+Real geometric_mean(Real a, Real b)
+{
+    return a == b ? a : std::sqrt(a * b);
+}
+/// Refuses to mix materials whose `name` differs (a switch, or a quantity with no mixing rule).
+template <class T>
+void agree(const T& a, const T& b, const char* name, const char* a_where, const char* b_where)
+{
+    if (!(a == b))
+        fail(a_where, ".", name, " and ", b_where, ".", name,
+             " differ: they have no mixing rule; give the pair's parameters (contact::materials)");
+}
 } // namespace detail
+
+/// How many particle materials Law tells apart (Law::material_count; 1 for a law without
+/// materials, which then takes every particle's material to be 0).
+template <class Law, class = void>
+struct law_material_count : std::integral_constant<unsigned, 1> {};
+template <class Law>
+struct law_material_count<Law, std::void_t<decltype(Law::material_count)>>
+    : std::integral_constant<unsigned, Law::material_count> {};
 
 /// Whether Law acts between particles that do not touch (Law::acts_apart).
 template <class Law, class = void>

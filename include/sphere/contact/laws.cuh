@@ -5,4 +5,5 @@
 #include "capillary.cuh"
 #include "hertz_mindlin.cuh"
 #include "linear.cuh"
+#include "materials.cuh"
 #include "rolling.cuh"

@@ -65,25 +65,54 @@ struct linear {
     /// 0.3 sqrt(m_min / k_max), about 10 steps (docs/physics.md, "Time step").
     static constexpr time_step_rule time_step{0.075, 0.3, "sqrt(m / k_max)"};
 
-    /// Throws sphere::error naming the first bad parameter.
+    /// Throws sphere::error naming the first bad parameter (where: the settings they came from).
     template <class Real>
-    static void validate(const contact_params<Real>& pair, const contact_params<Real>& wall)
+    static void validate(const contact_params<Real>& pair, const contact_params<Real>& wall,
+                         const char* pair_where = "settings.contact", const char* wall_where = "settings.wall")
     {
-        check(pair, "settings.contact");
-        check(wall, "settings.wall");
-        PairTangential::validate(pair, "settings.contact");
-        WallTangential::validate(wall, "settings.wall");
+        check(pair, pair_where);
+        check(wall, wall_where);
+        PairTangential::validate(pair, pair_where);
+        WallTangential::validate(wall, wall_where);
     }
 
+    /// A contact of materials a and b with the pair's parameters `contact`: those, as they
+    /// are (the linear law has no material constants).
+    template <class Real, class From>
+    static contact_params<Real> kernel(const contact_params<From>&, const contact_params<From>&,
+                                       const contact_params<From>& contact)
+    {
+        return params_cast<Real>(contact);
+    }
     template <class Real, class From>
     static contact_params<Real> pair_kernel(const contact_params<From>& pair)
     {
-        return params_cast<Real>(pair);
+        return kernel<Real>(pair, pair, pair);
     }
     template <class Real, class From>
-    static contact_params<Real> wall_kernel(const contact_params<From>&, const contact_params<From>& wall)
+    static contact_params<Real> wall_kernel(const contact_params<From>& pair, const contact_params<From>& wall)
     {
-        return params_cast<Real>(wall);
+        return kernel<Real>(pair, wall, wall);
+    }
+
+    /// The parameters of a contact between unlike materials a and b (docs/physics.md,
+    /// "Materials"): stiffnesses and viscosities as two half-contacts in series (2 a b / (a + b)),
+    /// friction coefficients by their geometric mean; tension and the damping convention must
+    /// agree. a_where, b_where name them in an error.
+    template <class Real>
+    static contact_params<Real> mix(const contact_params<Real>& a, const contact_params<Real>& b, const char* a_where,
+                                    const char* b_where)
+    {
+        detail::agree(a.tension, b.tension, "tension", a_where, b_where);
+        detail::agree(a.damping, b.damping, "damping", a_where, b_where);
+        contact_params<Real> out = a;
+        out.k_n = detail::series(a.k_n, b.k_n);
+        out.k_t = detail::series(a.k_t, b.k_t);
+        out.gamma_n = detail::series(a.gamma_n, b.gamma_n);
+        out.gamma_t = detail::series(a.gamma_t, b.gamma_t);
+        out.mu_s = detail::geometric_mean(a.mu_s, b.mu_s);
+        out.mu_d = detail::geometric_mean(a.mu_d, b.mu_d);
+        return out;
     }
 
     /// sqrt(m / k_max) (s), k_max the largest of k_n and k_t of pairs and walls.

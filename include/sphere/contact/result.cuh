@@ -15,6 +15,8 @@ struct contact_geometry {
     Real r_eff;    ///< effective radius (m): r_i r_j / (r_i + r_j) for a pair, r_i at a wall
     Real m_i, m_j; ///< masses (kg)
     Real m_eff;    ///< effective mass (kg): m_i m_j / (m_i + m_j) for a pair, m_i at a wall
+    unsigned material_i; ///< this particle's material index (0 unless the law tells materials apart)
+    unsigned material_j; ///< the partner's material index; at a wall, the wall's face (0 to 5)
 };
 
 /// The geometry and relative motion of one contact, as seen by the particle it acts on.

@@ -81,24 +81,47 @@ struct rolling {
         "tangential displacement (m) xyz, sliding flag w; lanes: rolling angle (rad) xyz, twisting angle (rad)";
     static constexpr time_step_rule time_step = Base::time_step;
 
-    /// Throws sphere::error naming the first bad parameter.
+    /// Throws sphere::error naming the first bad parameter (where: the settings they came from).
     template <class Real>
-    static void validate(const params<Real>& pair, const params<Real>& wall)
+    static void validate(const params<Real>& pair, const params<Real>& wall,
+                         const char* pair_where = "settings.contact", const char* wall_where = "settings.wall")
     {
-        Base::validate(pair, wall);
-        check(pair, "settings.contact");
-        check(wall, "settings.wall");
+        Base::validate(pair, wall, pair_where, wall_where);
+        check(pair, pair_where);
+        check(wall, wall_where);
     }
 
+    /// Particles of materials a and b with the pair's parameters `contact`.
+    template <class Real, class From>
+    static kernel_params<Real> kernel(const params<From>& a, const params<From>& b, const params<From>& contact)
+    {
+        return with<Real>(Base::template kernel<Real>(a, b, contact), contact);
+    }
     template <class Real, class From>
     static kernel_params<Real> pair_kernel(const params<From>& pair)
     {
-        return with<Real>(Base::template pair_kernel<Real>(pair), pair);
+        return kernel<Real>(pair, pair, pair);
     }
     template <class Real, class From>
     static kernel_params<Real> wall_kernel(const params<From>& pair, const params<From>& wall)
     {
         return with<Real>(Base::template wall_kernel<Real>(pair, wall), wall);
+    }
+
+    /// Unlike materials (docs/physics.md, "Materials"): the base law's mixing; stiffnesses and
+    /// viscosities in series, friction coefficients by their geometric mean.
+    template <class Real>
+    static params<Real> mix(const params<Real>& a, const params<Real>& b, const char* a_where, const char* b_where)
+    {
+        params<Real> out = a;
+        static_cast<typename Base::template params<Real>&>(out) = Base::mix(a, b, a_where, b_where);
+        out.mu_r = detail::geometric_mean(a.mu_r, b.mu_r);
+        out.k_r = detail::series(a.k_r, b.k_r);
+        out.gamma_r = detail::series(a.gamma_r, b.gamma_r);
+        out.mu_twist = detail::geometric_mean(a.mu_twist, b.mu_twist);
+        out.k_twist = detail::series(a.k_twist, b.k_twist);
+        out.gamma_twist = detail::series(a.gamma_twist, b.gamma_twist);
+        return out;
     }
 
     /// The base law's time scale, or sqrt(I / (2 k)) (s) with I = 2 m r^2 / 5 and k the stiffest

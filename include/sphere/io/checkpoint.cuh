@@ -219,6 +219,7 @@ public:
             const std::string field = std::string(what) + "." + name;
             if constexpr (std::is_floating_point_v<T>) v = T(f64(field.c_str()));
             else if constexpr (std::is_same_v<T, bool>) v = choice(field.c_str(), 1) == 1;
+            else if constexpr (std::is_integral_v<T>) v = static_cast<T>(choice(field.c_str(), std::numeric_limits<T>::max()));
             else v = static_cast<T>(choice(field.c_str(), largest_value(T{})));
         });
         return p;
@@ -329,6 +330,8 @@ std::string encode_checkpoint(const settings<Real, typename Law::template params
     for (const auto* field : {&p.mass, &p.pressure, &p.e_visc, &p.e_fric, &p.p_visc, &p.p_fric})
         e.array(*field, put_real);
     e.array(p.kind, [](checkpoint_encoder& out, std::uint8_t v) { out.u8(v); });
+    if (law_material_count<Law>::value > 1) // only a law with materials stores them (docs/io.md)
+        e.array(p.material, [](checkpoint_encoder& out, std::uint8_t v) { out.u8(v); });
     std::vector<unsigned> counts(n);
     for (std::size_t i = 0; i < n; ++i) counts[i] = static_cast<unsigned>(s.contacts.end(i) - s.contacts.begin(i));
     e.array(counts, put_u32);
@@ -476,6 +479,16 @@ checkpoint_data<Real, Law> decode_checkpoint(const std::string& bytes, const std
         if (p.kind[i] > last_motion)
             d.inconsistent("particle ", i, " has motion kind ", unsigned(p.kind[i]), ", at most ", unsigned(last_motion),
                            " is valid");
+    constexpr unsigned materials = law_material_count<Law>::value;
+    if (materials > 1) {
+        p.material = d.array<std::uint8_t>("the materials", n, 1, [](checkpoint_decoder& in) { return in.u8("a material"); });
+        for (std::size_t i = 0; i < n; ++i)
+            if (p.material[i] >= materials)
+                d.inconsistent("particle ", i, " has material ", unsigned(p.material[i]), ", but ", Law::name(), " has ",
+                               materials);
+    } else {
+        p.material.assign(n, 0);
+    }
     const std::vector<unsigned> counts = d.array<unsigned>("the contact counts", n, 4, get_u32);
     contact_table<Real>& t = st.contacts;
     t.offset.assign(n + 1, 0);

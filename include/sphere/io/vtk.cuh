@@ -158,6 +158,9 @@ std::string vtu_text(const particle_snapshot<Real>& p, double time)
     detail::vtk_scalars(out, "dissipated_frictional", p.e_fric);
     out << "        <DataArray type=\"UInt8\" Name=\"kind\" format=\"ascii\">\n";
     for (std::size_t i = 0; i < n; ++i) out << "          " << unsigned(p.kind[i]) << '\n';
+    out << "        </DataArray>\n";
+    out << "        <DataArray type=\"UInt8\" Name=\"material\" format=\"ascii\">\n";
+    for (std::size_t i = 0; i < n; ++i) out << "          " << unsigned(p.material[i]) << '\n';
     out << "        </DataArray>\n"
         << "      </PointData>\n"
         << "    </Piece>\n"
@@ -170,7 +173,8 @@ std::string vtu_text(const particle_snapshot<Real>& p, double time)
 /// Points are the particle centres (m); point data: radius (m), velocity (m/s) and
 /// angular_velocity (rad/s) at the time of the positions (v_sync, omega_sync), angular_position
 /// (rad), force (N) and torque (N m) of the last step's contacts, mass (kg), pressure (Pa),
-/// dissipated_viscous and dissipated_frictional (J), kind (0 free, 1 prescribed, 2 fixed, 3 prescribed_horizontal);
+/// dissipated_viscous and dissipated_frictional (J), kind (0 free, 1 prescribed, 2 fixed, 3 prescribed_horizontal),
+/// material (the material index, contact::materials);
 /// field data TimeValue (s). Throws sphere::error naming the file when it cannot be written.
 template <class Real>
 void write_vtu(const std::string& path, const particle_snapshot<Real>& p, double time)

@@ -30,6 +30,7 @@ struct particle {
     vec3<Real> velocity{0, 0, 0};         ///< (m/s)
     vec3<Real> angular_velocity{0, 0, 0}; ///< (rad/s)
     motion kind = motion::free;
+    std::uint8_t material = 0;            ///< material index, < the contact law's materials (contact::materials; 1 for other laws)
 };
 
 } // namespace sphere

@@ -44,6 +44,7 @@ struct particle_view {
     Real* p_visc;           ///< rate of e_visc in the last step (W)
     Real* p_fric;           ///< rate of e_fric in the last step (W)
     std::uint8_t* kind;     ///< motion, as its underlying value
+    std::uint8_t* material; ///< material index (contact::materials)
     unsigned* user;         ///< the user's index of the particle in each storage slot
 };
 
@@ -83,14 +84,15 @@ struct particle_snapshot {
     std::vector<vec3<Real>> v, omega, v_sync, omega_sync, angpos, force, torque;
     std::vector<Real> mass, pressure, e_visc, e_fric, p_visc, p_fric;
     std::vector<std::uint8_t> kind;
+    std::vector<std::uint8_t> material;
 
     std::size_t size() const { return x.size(); }
     vec3<Real> position(std::size_t i) const { return x[i].xyz(); }
     Real radius(std::size_t i) const { return x[i].w; }
 
     /// Particle descriptions from which a simulation is built before it restores a state with
-    /// this snapshot (restarts, insertion): positions, radii, velocities and kinds, densities
-    /// from the masses (mass / (4/3 pi r^3), in double).
+    /// this snapshot (restarts, insertion): positions, radii, velocities, kinds and materials,
+    /// densities from the masses (mass / (4/3 pi r^3), in double).
     std::vector<particle<Real>> descriptions() const
     {
         std::vector<particle<Real>> out(size());
@@ -102,6 +104,7 @@ struct particle_snapshot {
             out[i].velocity = v[i];
             out[i].angular_velocity = omega[i];
             out[i].kind = static_cast<motion>(kind[i]);
+            out[i].material = material[i];
         }
         return out;
     }
@@ -157,6 +160,7 @@ public:
         if (audit_)
             for (buffer<Real, Policy>* b : {&pressure_, &e_visc_, &e_fric_, &p_visc_, &p_fric_}) b->resize(n, Real(0));
         field(kind_, [](const particle<Coord>& p) { return static_cast<std::uint8_t>(p.kind); });
+        field(material_, [](const particle<Coord>& p) { return p.material; });
         std::vector<unsigned> identity(n);
         for (std::size_t i = 0; i < n; ++i) identity[i] = static_cast<unsigned>(i);
         user_.assign(std::move(identity));
@@ -173,7 +177,7 @@ public:
         return {x_.size(),       x_.data(),        v_.data(),         omega_.data(),     v_sync,
                 omega_sync,      angpos,           force_.data(),     torque_.data(),    mass_.data(),
                 audit(pressure_), audit(e_visc_), audit(e_fric_),   audit(p_visc_),    audit(p_fric_),
-                kind_.data(),    user_.data()};
+                kind_.data(),    material_.data(), user_.data()};
     }
 
     /// The user's index of the particle in each storage slot (host copy).
@@ -219,7 +223,7 @@ public:
         return {out(x_),     out(v_),      out(omega_),  out(distinct_sync_ ? v_sync_ : v_),
                 out(distinct_sync_ ? omega_sync_ : omega_),
                 out(angpos_), out(force_),  out(torque_), out(mass_),   out(pressure_),
-                out(e_visc_), out(e_fric_), out(p_visc_), out(p_fric_), out(kind_)};
+                out(e_visc_), out(e_fric_), out(p_visc_), out(p_fric_), out(kind_), out(material_)};
     }
 
     /// Replaces every field by a snapshot's, given in user order (for restarts and for
@@ -252,6 +256,7 @@ public:
             in(p_fric_, s.p_fric);
         }
         in(kind_, s.kind);
+        in(material_, s.material);
     }
 
 private:
@@ -272,6 +277,7 @@ private:
     {
         f(v_); f(omega_); f(v_sync_); f(omega_sync_); f(angpos_); f(torque_);
         f(mass_); f(pressure_); f(e_visc_); f(e_fric_); f(p_visc_); f(p_fric_); f(kind_);
+        f(material_);
     }
 
     /// Moves every carried field, the user indices and the `along` arrays through `order` by
@@ -300,7 +306,7 @@ private:
     buffer<vec4<Coord>, Policy> x_;
     buffer<vec3<Real>, Policy> v_, omega_, v_sync_, omega_sync_, angpos_, force_, torque_;
     buffer<Real, Policy> mass_, pressure_, e_visc_, e_fric_, p_visc_, p_fric_;
-    buffer<std::uint8_t, Policy> kind_;
+    buffer<std::uint8_t, Policy> kind_, material_;
     buffer<unsigned, Policy> user_;
     bool distinct_sync_ = true; ///< v_sync_, omega_sync_ hold their own values (else empty: v_, omega_)
     bool audit_ = true;         ///< the energy-audit arrays exist (else empty)
