@@ -143,9 +143,12 @@ TEMPLATE_TEST_CASE("a particle outside the world on a wall axis is rejected at s
     ps[2].position.y = Real(-0.125);
     REQUIRE_SPHERE_ERROR(build(s, ps), Contains("particle 2: position[1] = -0.125 m " + world_y));
 
-    // A centre exactly on a face is inside; on a periodic axis a centre outside the box is
-    // accepted and wrapped into it.
+    // A centre exactly on a face is inside the world (overlapping the wall by its radius, which
+    // settings.max_initial_overlap must then allow); on a periodic axis a centre outside the
+    // box is accepted and wrapped into it.
     ps[2].position.y = s.box.hi.y;
+    REQUIRE_SPHERE_ERROR(build(s, ps), Contains("particle 2 (radius " + fmt(ps[2].radius) + " m) starts overlapping wall face 3 by 1 "));
+    s.max_initial_overlap = 1;
     REQUIRE_NOTHROW(build(s, ps));
     ps[2].position.y = Real(0.125);
     s.box.axis[1] = sphere::boundary::periodic;
@@ -408,11 +411,11 @@ TEMPLATE_TEST_CASE("the time step must be positive, finite and within the stable
             s.dt = Real(1.01 * bound);
             REQUIRE_SPHERE_ERROR(build(s, ps),
                                  Contains("settings.dt = " + fmt(s.dt) +
-                                          " s exceeds the stable bound 0.3 sqrt(m / k_max) = ") &&
+                                          " s exceeds the stable bound 0.3 min(sqrt(m / k_max), t_d / 0.3) = ") &&
                                      Contains(" s of the contact law linear<elastic_viscous_frictional, "
                                               "visco_frictional> (smallest at particle 2: m = " +
                                               fmt(sphere::sphere_mass(ps[2].radius, ps[2].density)) +
-                                              " kg, k_max = " + fmt(Real(k_max)) + " N/m)"));
+                                              " kg, k_max = " + fmt(Real(k_max)) + " N/m, t_d = inf s)"));
         };
         check_bound(1e5); // k_n
         s.contact.k_t = Real(2e5);
@@ -421,6 +424,31 @@ TEMPLATE_TEST_CASE("the time step must be positive, finite and within the stable
         check_bound(4e5); // k_n of the walls
         s.wall.k_t = Real(8e5);
         check_bound(8e5); // k_t of the walls
+    }
+    SECTION("above the dashpots' stable step, for every damping convention")
+    {
+        // An explicit dashpot c on a contact of inverse effective mass w is stable for
+        // dt < t_d = 2 / (c w) (docs/physics.md, "Time step"): the lightest particle's contact
+        // with one like it, w = 2 / m_min along the normal. gamma_n = 1e6 N s/m (t_d = 1.3e-9 s)
+        // is refused at any dt above t_d; the default, 0.075 T with T = t_d / 0.3, is t_d / 4.
+        s.contact.gamma_n = Real(1e6);
+        const double t_d = 2 / (1e6 * 2 / m_min);
+        s.dt = Real(1.01 * t_d);
+        REQUIRE_SPHERE_ERROR(build(s, ps), Contains("exceeds the stable bound 0.3 min(sqrt(m / k_max), t_d / 0.3)") &&
+                                               Contains("t_d = " + fmt(Real(t_d)) + " s"));
+        s.dt = Real(0.99 * t_d);
+        REQUIRE_NOTHROW(build(s, ps));
+        s.dt = 0;
+        CHECK(double(sphere::simulation<Real>(s, ps).dt()) == Approx(0.25 * t_d).epsilon(1e-5));
+        // mass-scaled: c = gamma m_eff, so t_d = 2 / gamma along the normal of a pair; along the
+        // tangent w = 7 / m with c = gamma_t m / 2: t_d = 4 / (7 gamma_t)
+        s.contact.gamma_n = 0;
+        s.contact.damping = sphere::damping_convention::mass_scaled;
+        s.contact.gamma_t = Real(1e6);
+        s.dt = Real(1.01 * 4 / 7e6);
+        REQUIRE_SPHERE_ERROR(build(s, ps), Contains("t_d = " + fmt(Real(4 / 7e6)) + " s"));
+        s.dt = Real(0.99 * 4 / 7e6);
+        REQUIRE_NOTHROW(build(s, ps));
     }
 }
 
@@ -568,4 +596,57 @@ TEMPLATE_TEST_CASE("restitution helpers reject values outside their domain", "[e
         REQUIRE_SPHERE_ERROR(sphere::contact_duration(Real(1.5), m, k),
                              Contains("damping ratio zeta = 1.5: the restitution relations hold for 0 <= zeta < 1"));
     }
+}
+
+TEMPLATE_TEST_CASE("coincident centres and deep initial overlaps are refused, naming both particles", "[errors]", float,
+                   double, sphere::mixed)
+{
+    // Four balls of set P in a row along x; particle 3 is moved onto particle 1. A contact of
+    // coincident centres has no normal: always refused. An overlap beyond
+    // settings.max_initial_overlap (0.5 of the smaller radius by default) is refused unless
+    // raised, and initial_overlap() reports the deepest; walls likewise.
+    using Real = sphere_test::user_real<TestType>;
+    using Sim = sphere::simulation<TestType, sphere_test::policy>;
+    auto s = sphere_test::box_settings<Real>();
+    const double r = 0.01;
+    std::vector<sphere::particle<Real>> ps;
+    for (int k = 0; k < 4; ++k) ps.push_back(sphere_test::ball<Real>({Real(-0.06 + 0.03 * k), 0, 0}));
+    ps[3].position = ps[1].position;
+    REQUIRE_SPHERE_ERROR(Sim(s, ps), Contains("particles 1 and 3 have the same centre: their contact has no normal"));
+    ps[3].position.y = Real(2 * r - 0.6 * r); // overlap 0.6 r with particle 1 (along y), apart from the others
+    REQUIRE_SPHERE_ERROR(Sim(s, ps), Contains("particles 1 and 3 (radii " + fmt(ps[1].radius) + " and " +
+                                              fmt(ps[3].radius) + " m) start overlapping by 0.") &&
+                                         Contains("of the smaller radius, more than settings.max_initial_overlap = 0.5 "
+                                                  "(raise it to accept)"));
+    s.max_initial_overlap = 1;
+    CHECK(Sim(s, ps).initial_overlap() == Approx(0.6).epsilon(1e-4));
+    ps[3].position.y = Real(2 * r - 0.4 * r); // within the default
+    s.max_initial_overlap = Real(0.5);
+    CHECK(Sim(s, ps).initial_overlap() == Approx(0.4).epsilon(1e-4));
+    ps[0].position.x = Real(-0.1 + 0.3 * r); // 0.7 r into the wall at x = -0.1 (face 0)
+    const double into_wall = (double(ps[0].radius) - (double(ps[0].position.x) - double(s.box.lo.x))) / double(ps[0].radius);
+    REQUIRE_SPHERE_ERROR(Sim(s, ps), Contains("particle 0 (radius " + fmt(ps[0].radius) + " m) starts overlapping wall face 0 by " +
+                                              fmt(into_wall) + " of its radius, more than settings.max_initial_overlap = 0.5"));
+    s.max_initial_overlap = Real(-1);
+    REQUIRE_SPHERE_ERROR(Sim(s, ps), Contains("settings.max_initial_overlap = -1: must be non-negative"));
+}
+
+TEMPLATE_TEST_CASE("allocations that cannot succeed are sphere::errors that say how much was asked", "[errors]", float,
+                   double)
+{
+    // 2^40 doubles (8 TiB) cannot be had on any build machine: std::bad_alloc becomes a
+    // sphere::error; 2^62 values are more than a std::vector holds (std::length_error); the
+    // contact lists refuse more entries than their 32-bit offsets (and checkpoints) hold before
+    // allocating anything.
+    sphere::buffer<TestType, sphere::host> b;
+    REQUIRE_SPHERE_ERROR(b.resize(std::size_t(1) << 40),
+                         Contains("host memory: allocating 1099511627776 values of " + std::to_string(sizeof(TestType)) +
+                                  " B (") &&
+                             Contains(" GiB) failed"));
+    REQUIRE_SPHERE_ERROR(b.resize(std::size_t(1) << 62), Contains("values of " + std::to_string(sizeof(TestType)) +
+                                                                  " B are more than one array can hold"));
+    auto s = sphere_test::box_settings<TestType>();
+    sphere::simulation<TestType> sim(s, three<TestType>());
+    REQUIRE_SPHERE_ERROR(sim.reserve_contacts(std::size_t(1) << 33),
+                         Contains("reserve_contacts(8589934592): the contact lists hold at most 4294967295 entries"));
 }

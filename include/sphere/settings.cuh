@@ -23,6 +23,13 @@ struct settings {
     vec3<Real> gravity{0, 0, 0};    ///< (m/s^2)
     Real dt = 0;                    ///< time step (s); 0 selects the contact law's rule (linear: 0.075 min sqrt(m / max(k_n, k_t)))
     Real skin = 0;                  ///< contact-list skin (m); 0 rebuilds the lists every step, as sphere
+    /// The largest overlap two particles (or a particle and a wall) may start with, as a
+    /// fraction of the smaller radius; a deeper one is refused, naming both (docs/physics.md,
+    /// "Initial overlaps"). Raise it (to 1 or infinity) to accept deeper ones:
+    /// simulation::initial_overlap() reports the deepest. Coincident centres are always refused.
+    /// Not stored in checkpoints: a restart accepts the state it restores, as an insertion does
+    /// the particles already there.
+    Real max_initial_overlap = Real(0.5);
     /// Keep each contact's force of the last step (for the stress and contact-network analyses
     /// of analysis/stress.cuh); off saves 32 B (double) per listed pair and their stores.
     bool contact_forces = true;

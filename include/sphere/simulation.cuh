@@ -104,6 +104,53 @@ struct finish_block {
     }
 };
 
+/// The deepest overlap of particle pairs at setup, as a fraction of the smaller radius
+/// (coincident centres count as +infinity), and the user indices of its pair (the smallest
+/// pair among equal fractions, so the result does not depend on the order of the reduction).
+struct deepest_overlap {
+    static constexpr double coincident = 1e300; ///< the fraction of coincident centres
+    double fraction;
+    unsigned i, j;
+    SPHERE_HD bool before(const deepest_overlap& o) const
+    {
+        if (fraction != o.fraction) return fraction > o.fraction;
+        return i != o.i ? i < o.i : j < o.j;
+    }
+};
+struct deepest_overlap_op {
+    SPHERE_HD deepest_overlap operator()(const deepest_overlap& a, const deepest_overlap& b) const
+    {
+        return a.before(b) ? a : b;
+    }
+};
+
+/// The deepest overlap among the pairs of rank r's row in the contact lists.
+template <class P>
+struct row_overlap {
+    using Coord = coord_t<P>;
+    particle_view<P> p;
+    contact_view<real_t<P>> c;
+    world<Coord> box;
+    SPHERE_HD deepest_overlap operator()(std::size_t r) const
+    {
+        const std::size_t i = c.slot(r);
+        const vec4<Coord> xi = p.x[i];
+        const double coincident = deepest_overlap::coincident;
+        deepest_overlap out{0, ~0u, ~0u};
+        for (unsigned e = c.offset[r]; e < c.offset[r + 1] && c.partner[e] < wall_partner_base; ++e) {
+            const unsigned j = c.partner[e];
+            const vec4<Coord> xj = p.x[j];
+            const vec3<Coord> d = box.nearest_image_inside(xi.xyz() - xj.xyz());
+            const double dist = std::sqrt(double(norm2(d))), smaller = double(xi.w < xj.w ? xi.w : xj.w);
+            const double fraction = dist == 0 ? coincident : (double(xi.w) + double(xj.w) - dist) / smaller;
+            const unsigned ui = p.user[i], uj = p.user[j];
+            const deepest_overlap here{fraction, ui < uj ? ui : uj, ui < uj ? uj : ui};
+            if (here.before(out)) out = here;
+        }
+        return out;
+    }
+};
+
 /// What the host reads back at the end of a step, in one copy (docs/architecture.md,
 /// *Execution context*): the particles' loads on the walls (N), the particle check's largest
 /// squared displacement since the last rebuild (m^2, +infinity when a particle failed it), the
@@ -226,6 +273,9 @@ public:
             detail::fail("settings.gravity (", s.gravity.x, ", ", s.gravity.y, ", ", s.gravity.z, ") m/s^2 is not finite");
         if (!(s.skin >= 0) || !std::isfinite(s.skin))
             detail::fail("settings.skin = ", s.skin, " m: must be non-negative and finite");
+        if (!(s.max_initial_overlap >= 0))
+            detail::fail("settings.max_initial_overlap = ", s.max_initial_overlap,
+                         ": must be non-negative (a fraction of the smaller radius; infinity accepts any overlap)");
         if (!(s.cell_size >= 0) || !std::isfinite(s.cell_size))
             detail::fail("settings.cell_size = ", s.cell_size, " m: must be non-negative and finite (0 = automatic)");
         validate_wall_controls(s.walls, s.box);
@@ -246,6 +296,18 @@ public:
                 }
             }
             max_radius = p.radius > max_radius ? p.radius : max_radius;
+            for (int a = 0; a < 3; ++a) { // overlaps with the walls
+                if (s.box.periodic(a)) continue;
+                for (const bool hi : {false, true}) {
+                    const double gap = hi ? double(s.box.hi[a]) - double(p.position[a]) : double(p.position[a]) - double(s.box.lo[a]);
+                    const double fraction = (double(p.radius) - gap) / double(p.radius);
+                    initial_overlap_ = fraction > initial_overlap_ ? fraction : initial_overlap_;
+                    if (fraction > s.max_initial_overlap)
+                        detail::fail("particle ", i, " (radius ", p.radius, " m) starts overlapping wall face ", 2 * a + hi,
+                                     " by ", fraction, " of its radius, more than settings.max_initial_overlap = ",
+                                     s.max_initial_overlap, " (raise it to accept)");
+                }
+            }
         }
         largest_radius_ = max_radius;
         const time_scale_minimum<Coord> scale = smallest_time_scale<Law>(s.contact, s.wall, particles);
@@ -291,6 +353,7 @@ public:
             context_.read_back(&t, &report->lists, 1, "the contact lists' totals", 0);
             if (settle_rebuild(t, false)) break;
         }
+        refuse_initial_overlaps(s);
         // An integrator that kicks before the forces needs the forces of the start.
         if (Integrator::drifts_before_forces)
             settings_.contact_forces ? initial_forces<true>() : initial_forces<false>();
@@ -386,6 +449,9 @@ public:
     std::size_t steps() const { return steps_; }
     /// How many times the grid and contact lists were built (including at setup).
     std::size_t rebuilds() const { return rebuilds_; }
+    /// The deepest overlap the particles started with, as a fraction of the smaller radius (of
+    /// the particle's at a wall); settings.max_initial_overlap bounds it.
+    double initial_overlap() const { return initial_overlap_; }
     const settings_type& config() const { return settings_; }
     const wall_set<Coord>& walls() const { return walls_; }
     /// Work done on the particles by whatever drives the prescribed ones, so far (J); part of
@@ -402,7 +468,13 @@ public:
     /// Makes room in the contact lists for `entries` entries (as contact_entries() counts them)
     /// and as many carried histories, so that rebuilds up to that size neither allocate nor run
     /// a step twice. Without it the lists grow by themselves (see list_overflows()).
-    void reserve_contacts(std::size_t entries) { lists_.reserve(entries, entries); }
+    void reserve_contacts(std::size_t entries)
+    {
+        if (entries > std::numeric_limits<unsigned>::max())
+            detail::fail("reserve_contacts(", entries, "): the contact lists hold at most 4294967295 entries (32-bit "
+                         "offsets, as checkpoints store them)");
+        lists_.reserve(entries, entries);
+    }
     /// How many rebuilds found the lists too small, grew them and ran again (the first build's
     /// included): a step that does so reads back twice and allocates.
     std::size_t list_overflows() const { return lists_.overflows(); }
@@ -631,6 +703,7 @@ public:
         }
         settings_type s = settings_;
         s.dt = dt_;
+        s.max_initial_overlap = std::numeric_limits<Coord>::infinity(); // the added ones overlap nothing (above)
         simulation next(s, all);
         particle_snapshot<Coord>& ps = st.particles;
         for (const particle<Coord>& a : added) {
@@ -928,6 +1001,27 @@ private:
                          " has materials 0 to ", count - 1, count == 1 ? " (contact::materials<Law, Count> has more)" : "");
     }
 
+    /// Finds the deepest initial overlap of a pair (in the first lists, which hold every pair
+    /// within reach) and of a particle with a wall, and refuses coincident centres and any
+    /// overlap deeper than s.max_initial_overlap (docs/physics.md, "Initial overlaps").
+    void refuse_initial_overlaps(const settings_type& s)
+    {
+        auto& self = *this;
+        const detail::deepest_overlap pairs = transform_reduce(
+            Policy{}, size(), detail::row_overlap<Precision>{self.particles_.view(), self.lists_.view(), s.box},
+            detail::deepest_overlap{0, ~0u, ~0u}, detail::deepest_overlap_op{});
+        if (pairs.fraction >= detail::deepest_overlap::coincident)
+            detail::fail("particles ", pairs.i, " and ", pairs.j, " have the same centre: their contact has no normal");
+        initial_overlap_ = pairs.fraction > initial_overlap_ ? pairs.fraction : initial_overlap_;
+        const particle_snapshot<Coord> snap = pairs.fraction > s.max_initial_overlap ? particles_.snapshot()
+                                                                                       : particle_snapshot<Coord>{};
+        if (pairs.fraction > s.max_initial_overlap)
+            detail::fail("particles ", pairs.i, " and ", pairs.j, " (radii ", snap.radius(pairs.i), " and ",
+                         snap.radius(pairs.j), " m) start overlapping by ", pairs.fraction,
+                         " of the smaller radius, more than settings.max_initial_overlap = ", s.max_initial_overlap,
+                         " (raise it to accept)");
+    }
+
     /// Throws the error for particle i (a user index) at step `step`.
     [[noreturn]] void report_bad_particle(std::size_t i, std::size_t step) const
     {
@@ -966,6 +1060,7 @@ private:
     wall_set<Coord> walls_at_build_;      ///< the walls when the lists were built
     bool drive_ = false;                  ///< some particle is prescribed: book the drive's work
     buffer<vec3<Real>, Policy> external_; ///< external forces (empty until external_forces() is called)
+    double initial_overlap_ = 0;          ///< initial_overlap()
     std::vector<detail::wall_loads> wall_loads_; ///< each wall particle's loads of the step (host)
     std::size_t wall_launch_ = 0;
     /// Velocity Verlet: the last step's report holds the check of the positions the next drift

@@ -4,6 +4,7 @@
 /// and a swappable tangential law, one for particle pairs and one for walls.
 /// Equations and units: docs/physics.md, "Normal force" and "Tangential force".
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include "../core/error.cuh"
@@ -62,8 +63,9 @@ struct linear {
     static constexpr const char* history_layout = "tangential displacement (m) xyz, sliding flag w";
 
     /// sphere's rule: dt = 0.075 sqrt(m_min / k_max), about 40 steps per pair contact; at most
-    /// 0.3 sqrt(m_min / k_max), about 10 steps (docs/physics.md, "Time step").
-    static constexpr time_step_rule time_step{0.075, 0.3, "sqrt(m / k_max)"};
+    /// 0.3 sqrt(m_min / k_max), about 10 steps, and never above the dashpots' stable step t_d
+    /// (docs/physics.md, "Time step").
+    static constexpr time_step_rule time_step{0.075, 0.3, "min(sqrt(m / k_max), t_d / 0.3)"};
 
     /// Throws sphere::error naming the first bad parameter (where: the settings they came from).
     template <class Real>
@@ -115,17 +117,21 @@ struct linear {
         return out;
     }
 
-    /// sqrt(m / k_max) (s), k_max the largest of k_n and k_t of pairs and walls.
+    /// sqrt(m / k_max) (s), k_max the largest of k_n and k_t of pairs and walls, or, if smaller,
+    /// the dashpots' stable step divided by the bound's fraction (so that the bound is theirs).
     template <class Real>
     static Real time_scale(const contact_params<Real>& pair, const contact_params<Real>& wall, Real mass, Real)
     {
-        return std::sqrt(mass / stiffest(pair, wall));
+        const Real springs = std::sqrt(mass / stiffest(pair, wall));
+        const Real dashpots = dashpot_limit(pair, wall, mass) / Real(time_step.bound_factor);
+        return dashpots < springs ? dashpots : springs;
     }
     template <class Real>
     static std::string time_scale_inputs(const contact_params<Real>& pair, const contact_params<Real>& wall, Real mass,
                                          Real)
     {
-        return detail::text("m = ", mass, " kg, k_max = ", stiffest(pair, wall), " N/m");
+        return detail::text("m = ", mass, " kg, k_max = ", stiffest(pair, wall), " N/m, t_d = ",
+                            dashpot_limit(pair, wall, mass), " s");
     }
 
     /// Evaluates a pair contact with motion m, history entry h and time step dt (s).
@@ -189,6 +195,33 @@ private:
         out.visc_rate = fn.visc_rate + ft.visc_rate;
         out.fric_rate = ft.fric_rate;
         return out;
+    }
+
+    /// The largest step (s) at which every dashpot of a particle of mass m is stable in explicit
+    /// integration, dt < 2 / (c w), with c its coefficient (N s/m) and w the contact's inverse
+    /// effective mass: 2 / m with a particle like it and 1 / m at a wall along the normal, 7 / m
+    /// and 3.5 / m along the tangent, where rotation adds r^2 / I = 2.5 / m per particle
+    /// (docs/physics.md, "Time step"). +infinity without dashpots.
+    template <class Real>
+    static Real dashpot_limit(const contact_params<Real>& pair, const contact_params<Real>& wall, Real mass)
+    {
+        const Real limits[4] = {stable_step(pair, pair.gamma_n, mass / 2, Real(2) / mass),
+                                stable_step(wall, wall.gamma_n, mass, Real(1) / mass),
+                                stable_step(pair, pair.gamma_t, mass / 2, Real(7) / mass),
+                                stable_step(wall, wall.gamma_t, mass, Real(3.5) / mass)};
+        Real out = std::numeric_limits<Real>::infinity();
+        for (const Real t : limits) out = t < out ? t : out;
+        return out;
+    }
+    /// 2 / (c w) for the dashpot gamma of parameters p on a contact of effective mass m_eff and
+    /// inverse effective mass w.
+    template <class Real>
+    static Real stable_step(const contact_params<Real>& p, Real gamma, Real m_eff, Real w)
+    {
+        Real c = gamma;
+        if (p.damping == damping_convention::mass_scaled) c = gamma * m_eff;
+        else if (p.damping == damping_convention::damping_ratio) c = Real(2) * gamma * std::sqrt(m_eff * p.k_n);
+        return c > Real(0) ? Real(2) / (c * w) : std::numeric_limits<Real>::infinity();
     }
 
     template <class Real>

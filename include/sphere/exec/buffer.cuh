@@ -4,10 +4,13 @@
 /// buffer made or grown beyond its capacity) and every copy to the host counts in
 /// device_activity() on both backends.
 #include <cstddef>
+#include <new>
+#include <stdexcept>
 #include <utility>
 #include <vector>
 
 #include "../core/config.cuh"
+#include "../core/error.cuh"
 #include "activity.cuh"
 #include "cuda_error.cuh"
 #include "policy.cuh"
@@ -28,6 +31,21 @@ inline void count_growth(std::size_t size, std::size_t capacity)
 {
     if (size > capacity) ++device_activity().allocations;
 }
+
+/// Runs f, an allocation of n values of `bytes` bytes in host memory, and turns its failure
+/// (std::bad_alloc, std::length_error) into a sphere::error that says how much was asked.
+template <class F>
+void host_allocation(std::size_t n, std::size_t bytes, F&& f)
+{
+    try {
+        f();
+    } catch (const std::bad_alloc&) {
+        fail("host memory: allocating ", n, " values of ", bytes, " B (", double(n) * double(bytes) / 1073741824.0,
+             " GiB) failed");
+    } catch (const std::length_error&) {
+        fail("host memory: ", n, " values of ", bytes, " B are more than one array can hold");
+    }
+}
 } // namespace detail
 
 /// Host memory (a std::vector underneath).
@@ -36,7 +54,7 @@ class buffer<T, host> {
 public:
     using value_type = T;
     buffer() = default;
-    explicit buffer(std::size_t n, const T& value = T{}) : data_((detail::count_growth(n, 0), n), value) {}
+    explicit buffer(std::size_t n, const T& value = T{}) { resize(n, value); }
     buffer(const buffer& other) : data_((detail::count_growth(other.size(), 0), other.data_)) {}
     buffer(buffer&&) noexcept = default;
     buffer& operator=(const buffer& other)
@@ -53,7 +71,7 @@ public:
     void resize(std::size_t n, const T& value = T{})
     {
         detail::count_growth(n, data_.capacity());
-        data_.resize(n, value);
+        detail::host_allocation(n, sizeof(T), [&] { data_.resize(n, value); });
     }
     void assign(const std::vector<T>& values)
     {

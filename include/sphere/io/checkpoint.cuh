@@ -561,7 +561,9 @@ Sim restart(const std::string& path)
 {
     using Real = typename Sim::real_type;
     const checkpoint_data<Real, typename Sim::law_type> c = read_checkpoint<Real, typename Sim::law_type>(path);
-    Sim sim(c.config, c.particles());
+    typename Sim::settings_type config = c.config;
+    config.max_initial_overlap = std::numeric_limits<Real>::infinity(); // the state was accepted when it began
+    Sim sim(config, c.particles());
     sim.restore(c.state);
     return sim;
 }
