@@ -15,6 +15,7 @@
 #include <limits>
 #include <sstream>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 using Catch::Contains;
@@ -649,4 +650,39 @@ TEMPLATE_TEST_CASE("allocations that cannot succeed are sphere::errors that say 
     sphere::simulation<TestType> sim(s, three<TestType>());
     REQUIRE_SPHERE_ERROR(sim.reserve_contacts(std::size_t(1) << 33),
                          Contains("reserve_contacts(8589934592): the contact lists hold at most 4294967295 entries"));
+}
+
+TEMPLATE_TEST_CASE("radii and densities whose mass or time step make no sense are refused with the reason",
+                   "[errors][time step]", float, double, sphere::mixed)
+{
+    // A radius of 1e-30 m: in float its mass underflows; in double it is a number, but the
+    // time step 0.075 sqrt(m / k) = 2.4e-47 s would never end a run. A density of 1e300 kg/m^3
+    // overflows the mass in mixed, whose kernels compute in float (in float it is infinite).
+    using Real = sphere_test::user_real<TestType>;
+    using Sim = sphere::simulation<TestType, sphere_test::policy>;
+    constexpr bool single = sphere_test::single_fields<TestType>;
+    auto s = sphere_test::box_settings<Real>();
+    std::vector<sphere::particle<Real>> ps{sphere_test::ball<Real>({0, 0, 0})};
+    ps[0].radius = Real(1e-30);
+    if (single) {
+        REQUIRE_SPHERE_ERROR(Sim(s, ps), Contains("particle 0: radius ") &&
+                                             Contains("float cannot hold as normal numbers"));
+    } else {
+        REQUIRE_SPHERE_ERROR(Sim(s, ps), Contains("s is below 1e-15 s: a second of simulated time would take more "
+                                                  "than 1e15 steps; check the smallest radius and density"));
+    }
+    ps[0].radius = Real(0.01);
+    ps[0].density = Real(1e300);
+    if (std::is_same_v<TestType, float>) { // 1e300 is already infinite in float
+        REQUIRE_SPHERE_ERROR(Sim(s, ps), Contains("particle 0: density = inf kg/m^3 must be positive and finite"));
+    } else if (single) {
+        REQUIRE_SPHERE_ERROR(Sim(s, ps), Contains("particle 0: radius 0.01") &&
+                                             Contains("float cannot hold as normal numbers"));
+    } else {
+        CHECK_NOTHROW(Sim(s, ps));
+    }
+    // a user time step below the floor
+    ps[0].density = Real(2500);
+    s.dt = Real(1e-16);
+    REQUIRE_SPHERE_ERROR(Sim(s, ps), Contains("s is below 1e-15 s") && Contains("and settings.dt"));
 }

@@ -288,6 +288,7 @@ public:
         for (std::size_t i = 0; i < particles.size(); ++i) {
             particle<Coord>& p = particles[i];
             for (int a = 0; a < 3; ++a) p.position[a] = s.box.wrap(p.position[a], a);
+            refuse_unrepresentable_mass(i, p);
             if constexpr (!std::is_same_v<Real, Coord>) {
                 fits_real(sphere_mass(p.radius, p.density), " kg", "particle ", i, ": mass (radius ", p.radius, " m, density ", p.density, " kg/m^3)");
                 for (int a = 0; a < 3; ++a) {
@@ -325,6 +326,10 @@ public:
             dt_ = s.dt;
         }
         dt_ = Coord(Real(dt_)); // the kernels step velocities with dt in Real: one dt throughout
+        if (!(dt_ >= Coord(smallest_time_step)))
+            detail::fail("the time step ", dt_, " s is below 1e-15 s: a second of simulated time ",
+                         "would take more than 1e15 steps; check the smallest radius and density (",
+                         s.dt == Coord(0) ? "dt follows from them and the stiffness" : "and settings.dt", ")");
         for (int a = 0; a < 3; ++a) {
             const double reach = std::max(std::fabs(double(s.box.lo[a])), std::fabs(double(s.box.hi[a])));
             drift_margin_ = std::max(drift_margin_, 16 * double(std::numeric_limits<Coord>::epsilon()) * reach);
@@ -999,6 +1004,24 @@ private:
         if (material >= count)
             detail::fail(before, "particle ", i, ": material = ", material, ", but the contact law ", Law::name(),
                          " has materials 0 to ", count - 1, count == 1 ? " (contact::materials<Law, Count> has more)" : "");
+    }
+
+    /// The smallest time step a simulation accepts (s): below it a second of simulated time
+    /// takes more than 1e15 steps (docs/physics.md, "Time step").
+    static constexpr double smallest_time_step = 1e-15;
+
+    /// Refuses particle i (a user index) when its mass or moment of inertia is not a normal
+    /// number in the type the kernels compute in (zero, subnormal or infinite: a radius of
+    /// 1e-30 m, a density of 1e300 kg/m^3 in float).
+    static void refuse_unrepresentable_mass(std::size_t i, const particle<Coord>& p)
+    {
+        const double m = double(sphere_mass(p.radius, p.density));
+        const double inertia = 0.4 * m * double(p.radius) * double(p.radius);
+        const Real m_real = Real(m), inertia_real = Real(inertia);
+        if (!std::isnormal(m_real) || !std::isnormal(inertia_real))
+            detail::fail("particle ", i, ": radius ", p.radius, " m and density ", p.density, " kg/m^3 give a mass of ", m,
+                         " kg and a moment of inertia of ", inertia, " kg m^2, which ",
+                         sizeof(Real) == 4 ? "float" : "double", " cannot hold as normal numbers");
     }
 
     /// Finds the deepest initial overlap of a pair (in the first lists, which hold every pair
