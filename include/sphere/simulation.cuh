@@ -288,7 +288,6 @@ public:
         for (std::size_t i = 0; i < particles.size(); ++i) {
             particle<Coord>& p = particles[i];
             for (int a = 0; a < 3; ++a) p.position[a] = s.box.wrap(p.position[a], a);
-            refuse_unrepresentable_mass(i, p);
             if constexpr (!std::is_same_v<Real, Coord>) {
                 fits_real(sphere_mass(p.radius, p.density), " kg", "particle ", i, ": mass (radius ", p.radius, " m, density ", p.density, " kg/m^3)");
                 for (int a = 0; a < 3; ++a) {
@@ -296,6 +295,7 @@ public:
                     fits_real(p.angular_velocity[a], " rad/s", "particle ", i, ": angular_velocity[", a, "]");
                 }
             }
+            refuse_unrepresentable_mass(i, p); // after fits_real, whose message names what overflows
             max_radius = p.radius > max_radius ? p.radius : max_radius;
             for (int a = 0; a < 3; ++a) { // overlaps with the walls
                 if (s.box.periodic(a)) continue;
