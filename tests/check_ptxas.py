@@ -7,7 +7,7 @@ beyond the budget below.
 
 A kernel is named by its body: the functor of for_each_index, or the transform of a reduction
 (`reduce(then_check<...>)`). Hot are all of sphere's kernels but the diagnostics (energies,
-momentum, the search for a bad particle, single-value kernels); the library's own kernels
+momentum, the search for a bad particle, the count of broken bonds, single-value kernels); the library's own kernels
 (Thrust's and CUB's sorts and scans over plain keys) are listed but not judged.
 
 BUDGET holds the hot kernels that still exceed zero (issue 10), each with the most stack and
@@ -19,7 +19,7 @@ import re
 import subprocess
 import sys
 
-DIAGNOSTICS = ("particle_energy", "particle_momentum", "bad_particle", "set_kinematics")
+DIAGNOSTICS = ("particle_energy", "particle_momentum", "bad_particle", "set_kinematics", "bond_energy", "broken_bond")
 
 # (pattern on the kernel's name, stack bytes, spill bytes): the largest over the architectures
 # and precisions that match.

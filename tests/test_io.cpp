@@ -93,6 +93,12 @@ void require_identical(const sphere::simulation_state<Real>& a, const sphere::si
     CHECK(same_bits(a.storage, b.storage));
     CHECK(same_bits(a.x_at_build, b.x_at_build));
     CHECK(same_bits(a.drive_work, b.drive_work));
+    const auto& c = a.bonds;
+    const auto& d = b.bonds;
+    CHECK((same_bits(c.i, d.i) && same_bits(c.j, d.j) && same_bits(c.rest, d.rest) && same_bits(c.shear, d.shear)));
+    CHECK((same_bits(c.bend, d.bend) && same_bits(c.broken, d.broken) && same_bits(c.released, d.released)));
+    CHECK((same_bits(c.dissipated, d.dissipated) && same_bits(c.force, d.force) && same_bits(c.torque_i, d.torque_i) &&
+           same_bits(c.torque_j, d.torque_j)));
     for (int f = 0; f < 6; ++f) {
         INFO("wall face " << f);
         CHECK(a.walls.face[f].active == b.walls.face[f].active);
@@ -359,42 +365,54 @@ TEMPLATE_TEST_CASE("a writer killed while writing leaves the previous checkpoint
     CHECK_FALSE(fs::exists(tmp));
 }
 
-TEMPLATE_TEST_CASE("format version 4 checkpoints, from before the contact-law interface, still load",
+TEMPLATE_TEST_CASE("format version 5 and 4 checkpoints, from before the bonds and the contact-law interface, still load",
                    "[io][checkpoint]", float, double)
 {
-    // Version 4 is version 5 without the law's name and history layout at the start of the
-    // payload (docs/io.md): a version 4 file made so from a version 5 one reads back to the
-    // same settings and state, and restarts; a reader with another law's parameters refuses it.
+    // Version 5 is version 6 without the bond section at the end of the payload (for no bonds:
+    // settings.bond's 6 f64, the bond count and 11 empty arrays, 144 bytes), and version 4 is
+    // version 5 without the law's name and history layout at its start (docs/io.md): files
+    // made so from a version 6 one read back to the same settings and state, and restart; a
+    // reader with another law's parameters refuses version 4.
     using Real = TestType;
     temp_folder dir;
     host_sim<Real> sim = eventful_run<Real>(100);
-    const std::string v5 = dir / "v5.ck", v4 = dir / "v4.ck";
-    sphere::write_checkpoint(v5, sim);
-    std::string b = read_bytes(v5);
+    const std::string v6 = dir / "v6.ck", v5 = dir / "v5.ck", v4 = dir / "v4.ck";
+    sphere::write_checkpoint(v6, sim);
+    // The bytes of `b` as format `version`, without `count` payload bytes from `at`.
+    const auto older = [](std::string b, std::uint32_t version, std::size_t at, std::size_t count) {
+        b.erase(at, count);
+        b.resize(b.size() - 8);
+        b[8] = static_cast<char>(version);
+        const std::uint64_t payload = b.size() - 24;
+        for (int k = 0; k < 8; ++k) b[16 + k] = static_cast<char>((payload >> (8 * k)) & 0xffu);
+        const std::uint64_t sum = sphere::detail::fnv1a64(b.data(), b.size());
+        for (int k = 0; k < 8; ++k) b += static_cast<char>((sum >> (8 * k)) & 0xffu);
+        return b;
+    };
+    const std::string b6 = read_bytes(v6);
+    const std::string b5 = older(b6, 5, b6.size() - 8 - 144, 144);
+    write_bytes(v5, b5);
     const std::string name = sphere::contact::linear<>::name(), layout = sphere::contact::linear<>::history_layout;
-    const std::size_t law_bytes = 16 + name.size() + layout.size();
-    b.erase(24, law_bytes);
-    b.resize(b.size() - 8);
-    b[8] = 4;
-    const std::uint64_t payload = b.size() - 24;
-    for (int k = 0; k < 8; ++k) b[16 + k] = static_cast<char>((payload >> (8 * k)) & 0xffu);
-    const std::uint64_t sum = sphere::detail::fnv1a64(b.data(), b.size());
-    for (int k = 0; k < 8; ++k) b += static_cast<char>((sum >> (8 * k)) & 0xffu);
-    write_bytes(v4, b);
+    write_bytes(v4, older(b5, 4, 24, 16 + name.size() + layout.size()));
+    const sphere::checkpoint_data<Real> now = sphere::read_checkpoint<Real>(v6);
+    require_identical(sphere::read_checkpoint<Real>(v5).state, now.state);
+    host_sim<Real> b = sphere::restart<host_sim<Real>>(v5);
+    b.run(50);
 
-    const sphere::checkpoint_data<Real> old = sphere::read_checkpoint<Real>(v4), now = sphere::read_checkpoint<Real>(v5);
+    const sphere::checkpoint_data<Real> old = sphere::read_checkpoint<Real>(v4);
     require_identical(old.state, now.state);
     CHECK(old.config.contact.k_n == now.config.contact.k_n);
     CHECK(old.config.contact.mu_d == now.config.contact.mu_d);
     CHECK(old.config.wall.gamma_t == now.config.wall.gamma_t);
     CHECK(old.config.wall.damping == now.config.wall.damping);
-    host_sim<Real> a = sphere::restart<host_sim<Real>>(v4), c = sphere::restart<host_sim<Real>>(v5);
+    host_sim<Real> a = sphere::restart<host_sim<Real>>(v4), c = sphere::restart<host_sim<Real>>(v6);
     a.run(50);
     c.run(50);
     require_identical(a.state(), c.state());
+    require_identical(b.state(), c.state());
     CHECK_THROWS_WITH((sphere::read_checkpoint<Real, sphere::contact::hertz_mindlin<>>(v4)),
-                      Catch::Contains("format version 4, but this build reads version 5 only for a contact law other "
-                                      "than the linear one, which version 4 does not describe"));
+                      Catch::Contains("format version 4, but this build reads versions 6 and 5, and 4 only for the "
+                                      "linear contact law, which version 4 describes"));
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -443,10 +461,10 @@ TEMPLATE_TEST_CASE("broken checkpoints raise the documented errors", "[io][check
         CHECK(bytes.compare(40 + name.size(), layout.size(), layout) == 0);
         const std::size_t law_bytes = 16 + name.size() + layout.size(), at = 24 + law_bytes;
         CHECK(bytes.compare(0, 8, "SPHERECK") == 0);
-        CHECK(u32_at(8) == 5);
+        CHECK(u32_at(8) == 6);
         CHECK(u32_at(12) == sizeof(Real));
         CHECK(u64_at(16) == size - 32);
-        CHECK(size == 1036 + law_bytes + 289 * n + 36 * entries);
+        CHECK(size == 1180 + law_bytes + 289 * n + 36 * entries); // no bonds (docs/io.md)
         CHECK(f64_at(at + 40) == double(sim.config().box.hi.z)); // box.hi = settings bytes 24-47
         CHECK(u32_at(at + 48) == 0); // box.axis[0]: wall
         CHECK(f64_at(at + 60) == double(sim.config().contact.k_n));
@@ -522,11 +540,11 @@ TEMPLATE_TEST_CASE("broken checkpoints raise the documented errors", "[io][check
     SECTION("wrong version")
     {
         std::string b = bytes;
-        REQUIRE(b[8] == 5); // the version, little-endian u32 at byte 8
+        REQUIRE(b[8] == 6); // the version, little-endian u32 at byte 8
         b[8] = 3;
         write_bytes(bad, b);
         REQUIRE_THROWS_WITH(sphere::read_checkpoint<Real>(bad),
-                            where + "format version 3, but this build reads version 5, and 4 for the linear contact law");
+                            where + "format version 3, but this build reads versions 6 and 5, and 4 for the linear contact law");
     }
     SECTION("sizes that do not fit the particle count")
     {

@@ -2,9 +2,14 @@
 /// \file
 /// The DEM half of sphere: `#include <sphere/dem.cuh>` brings in particles, the neighbour
 /// grid, contact laws, walls, integrators, the simulation template and its diagnostics.
+#include "analysis/bond_rose.cuh"
 #include "analysis/porosity.cuh"
 #include "analysis/shear.cuh"
 #include "analysis/stress.cuh"
+#include "bonds/bond_forces.cuh"
+#include "bonds/bond_params.cuh"
+#include "bonds/bond_set.cuh"
+#include "bonds/bond_table.cuh"
 #include "boundary/wall_control.cuh"
 #include "boundary/walls.cuh"
 #include "boundary/world.cuh"
@@ -37,6 +42,7 @@
 #include "particles/state.cuh"
 #include "particles/validate.cuh"
 #include "settings.cuh"
+#include "setup/bond_pairs.cuh"
 #include "setup/insertion.cuh"
 #include "setup/layers.cuh"
 #include "setup/packing.cuh"

@@ -5,6 +5,7 @@
 
 #include "boundary/wall_control.cuh"
 #include "boundary/walls.cuh"
+#include "bonds/bond_params.cuh"
 #include "boundary/world.cuh"
 #include "contact/params.cuh"
 #include "contact/summation.cuh"
@@ -20,6 +21,7 @@ struct settings {
     world<Real> box;                ///< world box and per-axis boundaries
     Params contact;                 ///< particle-particle contacts
     Params wall;                    ///< particle-wall contacts (linear law: sphere's k_n, gamma_wn, gamma_wt, mu_ws, mu_wd)
+    bond_params<Real> bond;         ///< the parallel bonds, if the simulation has any (docs/physics.md, "Bonds")
     vec3<Real> gravity{0, 0, 0};    ///< (m/s^2)
     Real dt = 0;                    ///< time step (s); 0 selects the contact law's rule (linear: 0.075 min sqrt(m / max(k_n, k_t)))
     Real skin = 0;                  ///< contact-list skin (m); 0 rebuilds the lists every step, as sphere

@@ -11,6 +11,9 @@
 #include <utility>
 #include <vector>
 
+#include "bonds/bond_forces.cuh"
+#include "bonds/bond_set.cuh"
+#include "bonds/bond_table.cuh"
 #include "boundary/wall_control.cuh"
 #include "boundary/walls.cuh"
 #include "contact/contact_lists.cuh"
@@ -215,6 +218,7 @@ template <class Real>
 struct simulation_state {
     particle_snapshot<Real> particles;  ///< in user order
     contact_table<Real> contacts;        ///< the contact lists and their history (forces left out)
+    bond_table<Real> bonds;              ///< the bonds and their state
     std::vector<vec4<Real>> x_at_build; ///< positions when the lists were built, in user order
     std::vector<unsigned> storage;       ///< the user index of each storage slot (the storage order)
     wall_set<Real> walls;
@@ -261,7 +265,9 @@ public:
     using observer = std::function<void(const simulation&)>;
 
     /// Validates everything and builds the first contact lists; throws sphere::error on bad input.
-    simulation(const settings_type& s, std::vector<particle<Coord>> particles)
+    /// `bonds` joins pairs of particles (user indices) with parallel bonds of settings.bond at
+    /// their distance now (docs/physics.md, "Bonds"); their springs enter the time step.
+    simulation(const settings_type& s, std::vector<particle<Coord>> particles, const std::vector<bond>& bonds = {})
         : settings_(s), gravity_(vec_cast<Real>(s.gravity))
     {
         validate_world(s.box);
@@ -283,6 +289,8 @@ public:
         validate_particles(particles, s.box);
         for (std::size_t i = 0; i < particles.size(); ++i) check_material(i, particles[i].material, "");
         check_fits_real(s);
+        validate_bond_params(s.bond);
+        bond_params_ = params_cast<Real>(s.bond);
 
         Coord max_radius = 0;
         for (std::size_t i = 0; i < particles.size(); ++i) {
@@ -311,10 +319,13 @@ public:
             }
         }
         largest_radius_ = max_radius;
+        const bond_table<Coord> bonded = new_bonds(particles, {}, bonds, "");
         const time_scale_minimum<Coord> scale = smallest_time_scale<Law>(s.contact, s.wall, particles);
         const Coord bound = Coord(Law::time_step.bound_factor) * scale.scale;
+        const time_scale_minimum<Coord> bond_scale = smallest_bond_time_scale(particles, bonded);
         if (s.dt == Coord(0)) {
             dt_ = Coord(Law::time_step.default_factor) * scale.scale;
+            dt_ = std::min(dt_, Coord(bond_time_step::default_factor) * bond_scale.scale);
         } else if (!(s.dt > 0) || !std::isfinite(s.dt)) {
             detail::fail("settings.dt = ", s.dt, " s: must be positive and finite (0 = automatic)");
         } else if (s.dt > bound) {
@@ -324,6 +335,7 @@ public:
                          Law::time_scale_inputs(s.contact, s.wall, sphere_mass(p.radius, p.density), p.radius), ")");
         } else {
             dt_ = s.dt;
+            refuse_bond_step(dt_, bond_scale, bonded, "settings.dt = ");
         }
         dt_ = Coord(Real(dt_)); // the kernels step velocities with dt in Real: one dt throughout
         if (!(dt_ >= Coord(smallest_time_step)))
@@ -359,6 +371,7 @@ public:
             if (settle_rebuild(t, false)) break;
         }
         refuse_initial_overlaps(s);
+        set_bonds(bonded);
         // An integrator that kicks before the forces needs the forces of the start.
         if (Integrator::drifts_before_forces)
             settings_.contact_forces ? initial_forces<true>() : initial_forces<false>();
@@ -369,7 +382,7 @@ public:
     {
         const stream_scope<Policy> on_stream(context_);
         governor_.step();
-        if (external_.size()) step_with<true>();
+        if (external_.size() || bonds_.size()) step_with<true>();
         else step_with<false>();
     }
 
@@ -457,6 +470,31 @@ public:
     /// The deepest overlap the particles started with, as a fraction of the smaller radius (of
     /// the particle's at a wall); settings.max_initial_overlap bounds it.
     double initial_overlap() const { return initial_overlap_; }
+
+    /// Joins more pairs of particles (user indices) with bonds of settings.bond at their
+    /// distance now. Throws sphere::error, and adds none, for a pair that is invalid (see the
+    /// constructor) or whose bond needs a shorter time step than dt() (docs/physics.md, "Bonds").
+    void add_bonds(const std::vector<bond>& pairs)
+    {
+        if (pairs.empty()) return;
+        const particle_snapshot<Coord> snap = particles_.snapshot();
+        std::vector<particle<Coord>> described = snap.descriptions();
+        const bond_table<Coord> all = new_bonds(described, bonds_.table(), pairs, "add_bonds: ");
+        const time_scale_minimum<Coord> scale = smallest_bond_time_scale(described, all);
+        refuse_bond_step(dt_, scale, all, "add_bonds: the time step dt() = ");
+        const stream_scope<Policy> on_stream(context_);
+        set_bonds(all);
+        drift_checked_ = false; // the next drift sees the new bonds' loads
+    }
+
+    /// Every bond and its state, in the order of creation (user indices).
+    bond_table<Coord> bonds() const { return bonds_.table(); }
+
+    /// How many bonds the simulation has, broken ones included.
+    std::size_t bond_count() const { return bonds_.size(); }
+
+    /// How many bonds have broken so far.
+    std::size_t broken_bonds() const { return bonds_.broken(); }
     const settings_type& config() const { return settings_; }
     const wall_set<Coord>& walls() const { return walls_; }
     /// Work done on the particles by whatever drives the prescribed ones, so far (J); part of
@@ -516,7 +554,8 @@ public:
         } else {
             if (!predicts_drift()) return false;
             const stream_scope<Policy> on_stream(context_);
-            if (external_.size())
+            if (bonds_.size() && external_.size()) bond_loads(nullptr); // the external forces just written
+            if (external_.size() || bonds_.size())
                 predict_drift_with<true>(out);
             else
                 predict_drift_with<false>(out);
@@ -529,7 +568,7 @@ public:
     void predict_drift_with(Coord* out)
     {
         const detail::drift_particles<Precision, Integrator, External> drift{
-            particles_.view(), settings_.box, gravity_, Real(dt_), External ? external_.data() : nullptr};
+            particles_.view(), settings_.box, gravity_, Real(dt_), External ? external_loads() : nullptr};
         transform_reduce_into(context_, size(), detail::check_after_drift<Precision, Integrator, External>{drift, check()},
                               Coord(0), max_op{}, out);
     }
@@ -553,6 +592,11 @@ public:
                                                            pair_params_, wall_params_, settings_.gravity};
         energy_budget<Coord> e = transform_reduce(Policy{}, size(), detail::by_rank<decltype(each), Real>{each, c},
                                                   energy_budget<Coord>{}, plus_op{});
+        if (bonds_.size())
+            e = e + transform_reduce(Policy{}, bonds_.size(),
+                                     detail::bond_energy<Precision>{self.particles_.view(), self.bonds_.view(),
+                                                                    settings_.box, bond_params_},
+                                     energy_budget<Coord>{}, plus_op{});
         double work = drive_work_;
         for (const wall_face<Coord>& w : walls_.face) work += w.work;
         e.boundary_work = Coord(work);
@@ -571,6 +615,7 @@ public:
         simulation_state<Coord> st;
         st.particles = particles_.snapshot();
         st.contacts = std::move(contacts);
+        st.bonds = bonds_.table();
         st.x_at_build = std::move(x_at_build);
         st.storage = user;
         st.walls = walls_;
@@ -611,6 +656,7 @@ public:
                 detail::fail("restore: the state's storage order is not a permutation (slot ", k, " holds ", s.storage[k], ")");
             seen[s.storage[k]] = 1;
         }
+        check_bond_table(s.bonds);
         const stream_scope<Policy> on_stream(context_);
         // The ranks of the last rebuild follow from its positions and the user indices: the
         // grid over those positions, in user order. The particles go back into rank order
@@ -667,6 +713,7 @@ public:
         needs_rebuild_ = s.needs_rebuild;
         time_ = static_cast<double>(steps_) * static_cast<double>(dt_);
         drift_checked_ = false;
+        set_bonds(s.bonds, false); // with the loads of their last evaluation
     }
 
     /// Adds particles during a run (particle insertion): they take the user indices size() to
@@ -757,6 +804,7 @@ private:
         interaction_.lists_changed();
         if (settings_.reorder) {
             particles_.permute(g.order, x_at_build_.data(), external_);
+            bonds_.locate(particles_.view());
         } else {
             const particle_view<Precision> p = particles_.view();
             for_each_index(Policy{}, p.n, detail::copy_back<vec4<Coord>>{p.x, x_at_build_.data()});
@@ -800,12 +848,13 @@ private:
         // addresses stay), and external forces are permuted along with the particles.
         const particle_view<Precision> p = particles_.view();
         const std::size_t n = p.n;
-        const vec3<Real>* external = External ? external_.data() : nullptr;
+        const vec3<Real>* external = External ? external_loads() : nullptr;
+        const vec3<Real>* external_torque = External && bonds_.size() ? load_torque_.data() : nullptr;
         constexpr bool drifted = Integrator::drifts_before_forces;
-        const detail::integrate_particles<Precision, Integrator, External> integrate{p, settings_.box, gravity_,
-                                                                                   Real(dt_), external};
+        const detail::integrate_particles<Precision, Integrator, External> integrate{
+            p, settings_.box, gravity_, Real(dt_), external, external_torque};
         const detail::drift_particles<Precision, Integrator, External> drift{p, settings_.box, gravity_, Real(dt_),
-                                                                            external};
+                                                                            external, external_torque};
         detail::step_report<Coord>* report = report_.data(); // policy memory
         const unsigned* halt = &report->lists.overflow;
         if constexpr (drifted) {
@@ -825,10 +874,12 @@ private:
         // From here the step may run twice: when its rebuild overflows the lists' capacities,
         // nothing that lasts changes (the bodies see *halt), the capacities grow and it runs
         // again, to the same bits as with room from the start.
+        if (drifted && bonds_.size() && external_.size()) bond_loads(nullptr); // the external forces of now
         const bool rebuild = needs_rebuild_;
         detail::step_report<Coord> done{};
         do {
             if (rebuild) rebuild_lists(&report->lists);
+            if (bonds_.size()) bond_pass<Book>(halt, true);
             // the check at the end: of where the particles are, or of where the next drift puts them
             const auto finish = [&](const auto& checks) {
                 if constexpr (Book) {
@@ -994,6 +1045,10 @@ private:
                         fits_real(value, (*unit ? std::string(" ") + unit : std::string()).c_str(), where, ".", name);
                 });
             for (int a = 0; a < 3; ++a) fits_real(s.gravity[a], " m/s^2", "settings.gravity[", a, "]");
+            bond_params<Coord>::fields(s.bond, [&](const char* name, Coord value, const char* unit) {
+                if (std::isfinite(value)) // an infinite strength is a strength never reached
+                    fits_real(value, (*unit ? std::string(" ") + unit : std::string()).c_str(), "settings.bond.", name);
+            });
         }
     }
 
@@ -1061,6 +1116,131 @@ private:
                      walls_.face[5].position, "] m");
     }
 
+    /// The bonds of `existing` and of `pairs` (user indices into `particles`, whose positions
+    /// and radii give the rest lengths): refuses an index out of range, a particle bonded to
+    /// itself, a pair bonded twice, centres farther apart than twice the sum of radii, and
+    /// bonds without a normal stiffness; `before` prefixes the message.
+    bond_table<Coord> new_bonds(const std::vector<particle<Coord>>& particles, bond_table<Coord> existing,
+                                const std::vector<bond>& pairs, const char* before) const
+    {
+        if (pairs.empty()) return existing;
+        if (!(settings_.bond.k_n > 0))
+            detail::fail(before, "settings.bond.k_n = ", settings_.bond.k_n, " Pa/m: bonds need a positive normal stiffness");
+        std::vector<std::pair<unsigned, unsigned>> known;
+        for (std::size_t k = 0; k < existing.size(); ++k)
+            known.emplace_back(std::min(existing.i[k], existing.j[k]), std::max(existing.i[k], existing.j[k]));
+        std::sort(known.begin(), known.end());
+        for (std::size_t k = 0; k < pairs.size(); ++k) {
+            const bond b = pairs[k];
+            if (b.i >= particles.size() || b.j >= particles.size())
+                detail::fail(before, "bond ", k, " joins particles ", b.i, " and ", b.j, ", but there are ",
+                             particles.size(), " particles");
+            if (b.i == b.j) detail::fail(before, "bond ", k, " joins particle ", b.i, " to itself");
+            const std::pair<unsigned, unsigned> key{unsigned(std::min(b.i, b.j)), unsigned(std::max(b.i, b.j))};
+            const auto at = std::lower_bound(known.begin(), known.end(), key);
+            if (at != known.end() && *at == key)
+                detail::fail(before, "bond ", k, ": particles ", b.i, " and ", b.j, " are bonded already");
+            known.insert(at, key);
+            const particle<Coord>& a = particles[b.i];
+            const particle<Coord>& c = particles[b.j];
+            const Coord length = std::sqrt(norm2(settings_.box.nearest_image_inside(a.position - c.position)));
+            if (!(length <= 2 * (a.radius + c.radius)))
+                detail::fail(before, "bond ", k, ": particles ", b.i, " and ", b.j, " are ", length,
+                             " m apart, more than twice the sum of their radii (", a.radius + c.radius,
+                             " m): bonds join neighbours");
+            existing.add(unsigned(b.i), unsigned(b.j), length);
+        }
+        return existing;
+    }
+
+    /// The smallest bond time scale (bond_springs::time_scale) over the bonds of t, with the
+    /// bond's index in `particle` (0 and +infinity without bonds).
+    time_scale_minimum<Coord> smallest_bond_time_scale(const std::vector<particle<Coord>>& particles,
+                                                       const bond_table<Coord>& t) const
+    {
+        time_scale_minimum<Coord> out{infinity<Coord>, 0};
+        for (std::size_t k = 0; k < t.size(); ++k) {
+            const particle<Coord>& a = particles[t.i[k]];
+            const particle<Coord>& b = particles[t.j[k]];
+            const Coord scale = bond_springs<Coord>::time_scale(settings_.bond, a.radius, b.radius,
+                                                                sphere_mass(a.radius, a.density),
+                                                                sphere_mass(b.radius, b.density));
+            if (scale < out.scale) out = {scale, k};
+        }
+        return out;
+    }
+
+    /// Refuses a time step dt above the bonds' bound (bond_time_step) of their smallest time
+    /// scale `scale`; `before` names dt.
+    static void refuse_bond_step(Coord dt, const time_scale_minimum<Coord>& scale, const bond_table<Coord>& t,
+                                 const char* before)
+    {
+        const Coord bound = Coord(bond_time_step::bound_factor) * scale.scale;
+        if (dt > bound)
+            detail::fail(before, dt, " s exceeds the stable bound ", bond_time_step::bound_factor, " T_bond = ", bound,
+                         " s of bond ", scale.particle, " (particles ", t.i[scale.particle], " and ", t.j[scale.particle],
+                         "; T_bond = ", scale.scale, " s from settings.bond's stiffnesses, the radii and masses)");
+    }
+
+    /// Refuses a state's bond table whose arrays disagree or whose bonds join particles that
+    /// the simulation does not have.
+    void check_bond_table(const bond_table<Coord>& t) const
+    {
+        const std::size_t count = t.size();
+        for (std::size_t n : {t.j.size(), t.rest.size(), t.shear.size(), t.bend.size(), t.broken.size(), t.released.size(),
+                              t.dissipated.size(), t.force.size(), t.torque_i.size(), t.torque_j.size()})
+            if (n != count) detail::fail("restore: the state's bond table has arrays of ", count, " and ", n, " bonds");
+        for (std::size_t k = 0; k < count; ++k)
+            if (t.i[k] >= size() || t.j[k] >= size() || t.i[k] == t.j[k])
+                detail::fail("restore: bond ", k, " joins particles ", t.i[k], " and ", t.j[k], " (", size(),
+                             " particles)");
+    }
+
+    /// Makes `t` the bonds and sets every particle's bond loads: evaluated now from the state
+    /// as it is (`evaluate`), or summed from the loads the table holds (a restore, for the
+    /// same bits as the run that saved them).
+    void set_bonds(const bond_table<Coord>& t, bool evaluate = true)
+    {
+        bonds_.assign(t, size(), settings_.energy_audit);
+        if (!bonds_.size()) {
+            load_force_ = buffer<vec3<Real>, Policy>();
+            load_torque_ = buffer<vec3<Real>, Policy>();
+            return;
+        }
+        load_force_.resize(size());
+        load_torque_.resize(size());
+        bonds_.locate(particles_.view());
+        if (evaluate) bond_pass<false>(nullptr, false);
+        else bond_loads(nullptr);
+    }
+
+    /// Evaluates every bond (`update`: advancing and breaking them, bond_forces) and sums each
+    /// particle's bond loads, unless *halt (policy memory; null: run).
+    template <bool Book>
+    void bond_pass(const unsigned* halt, bool update)
+    {
+        using forces = detail::bond_forces<Precision, Integrator::drifts_before_forces, Book>;
+        const forces f{particles_.view(), bonds_.view(), settings_.box, bond_params_, Real(dt_), update};
+        if (halt) for_each_index(Policy{}, bonds_.size(), detail::unless_halted<forces>{f, halt});
+        else for_each_index(Policy{}, bonds_.size(), f);
+        bond_loads(halt);
+    }
+
+    /// Sums each particle's bond loads and external force (bond_loads) from the bonds' last
+    /// evaluation, unless *halt (null: run).
+    void bond_loads(const unsigned* halt)
+    {
+        const particle_view<Precision> p = particles_.view();
+        const detail::bond_loads<Precision> loads{p, bonds_.view(), external_.size() ? external_.data() : nullptr,
+                                                  load_force_.data(), load_torque_.data()};
+        if (halt) for_each_index(Policy{}, p.n, detail::unless_halted<detail::bond_loads<Precision>>{loads, halt});
+        else for_each_index(Policy{}, p.n, loads);
+    }
+
+    /// What the integrator adds to the contact forces: the external forces, with the bonds'
+    /// loads when there are bonds.
+    const vec3<Real>* external_loads() { return bonds_.size() ? load_force_.data() : external_.data(); }
+
     settings_type settings_;
     kernel_params pair_params_, wall_params_; ///< what the law's kernels receive for settings_.contact and .wall
     Coord range_ = 0; ///< the largest gap at which the law acts (contact/law.cuh): the lists reach that much further
@@ -1094,6 +1274,9 @@ private:
     std::vector<motion> kinds_; ///< host copy of each particle's motion (it never changes)
     std::vector<std::pair<std::size_t, observer>> observers_;
     thread_governor governor_; ///< all threads or one, whichever is faster on this machine now
+    bond_params<Real> bond_params_; ///< settings_.bond in the particles' precision
+    bond_set<Precision, Policy> bonds_;
+    buffer<vec3<Real>, Policy> load_force_, load_torque_; ///< with bonds: each slot's bond loads and external force
 };
 
 } // namespace sphere

@@ -21,16 +21,19 @@ struct energy_budget {
     Real rotational = 0;      ///< sum I |omega|^2 / 2, I = 2/5 m r^2
     Real potential = 0;       ///< sum -m g . x (zero at the origin)
     Real elastic = 0;         ///< energy stored in the contact springs, normal and tangential
-    Real dissipated_visc = 0; ///< total viscous dissipation so far
+    Real dissipated_visc = 0; ///< total viscous dissipation so far (the bonds' dashpots' too)
     Real dissipated_fric = 0; ///< total frictional dissipation so far
     Real rate_visc = 0;       ///< viscous dissipation rate in the last step
     Real rate_fric = 0;       ///< frictional dissipation rate in the last step
     Real boundary_work = 0;   ///< work done on the particles by moving walls so far
+    Real bond_elastic = 0;    ///< energy stored in the intact bonds (the seeds' 'bondpot')
+    Real bond_broken = 0;     ///< elastic energy the bonds held when they broke, lost with them
 
     /// Mechanical energy plus everything dissipated, less the work the walls did: constant.
     SPHERE_HD Real total() const
     {
-        return kinetic + rotational + potential + elastic + dissipated_visc + dissipated_fric - boundary_work;
+        return kinetic + rotational + potential + elastic + bond_elastic + dissipated_visc + dissipated_fric +
+               bond_broken - boundary_work;
     }
 
     SPHERE_HD energy_budget operator+(const energy_budget& b) const
@@ -43,7 +46,9 @@ struct energy_budget {
                 dissipated_fric + b.dissipated_fric,
                 rate_visc + b.rate_visc,
                 rate_fric + b.rate_fric,
-                boundary_work + b.boundary_work};
+                boundary_work + b.boundary_work,
+                bond_elastic + b.bond_elastic,
+                bond_broken + b.bond_broken};
     }
 };
 

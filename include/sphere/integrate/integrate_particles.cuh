@@ -42,14 +42,20 @@ SPHERE_HDI vec3<Real> linear_acceleration(const particle_view<P>& p, std::size_t
     return a;
 }
 
-/// linear_acceleration and the angular acceleration (rad/s^2).
+/// linear_acceleration and the angular acceleration (rad/s^2), with `External` the external
+/// torque too where there is one (`external_torque` not null: the bonds').
 template <bool External, class P, class Real = real_t<P>>
 SPHERE_HDI void accelerations(const particle_view<P>& p, std::size_t i, motion kind, const vec3<Real>& gravity,
-                              const vec3<Real>* external, vec3<Real>& a, vec3<Real>& alpha)
+                              const vec3<Real>* external, const vec3<Real>* external_torque, vec3<Real>& a,
+                              vec3<Real>& alpha)
 {
     a = linear_acceleration<External>(p, i, kind, gravity, external);
     const Real m = p.mass[i], r = Real(p.x[i].w);
-    alpha = p.torque[i] * (kind == motion::free ? Real(1) / (Real(0.4) * m * r * r) : Real(0));
+    vec3<Real> torque = p.torque[i]; // not const: see the note in contact/evaluate.cuh
+    if constexpr (External) {
+        if (external_torque) torque += external_torque[i];
+    }
+    alpha = torque * (kind == motion::free ? Real(1) / (Real(0.4) * m * r * r) : Real(0));
 }
 
 /// Advances particle i by dt after the forces: free particles with the integrator policy,
@@ -72,6 +78,7 @@ struct integrate_particles {
     vec3<Real> gravity;
     Real dt;
     const vec3<Real>* external; ///< external force on each particle (N), read with External
+    const vec3<Real>* external_torque = nullptr; ///< external torque (N m), read with External unless null
 
     SPHERE_HDI void operator()(std::size_t i) const
     {
@@ -81,7 +88,7 @@ struct integrate_particles {
         vec3<Coord> pos = x.xyz();
         vec3<Real> v = p.v[i], w = p.omega[i], angle{0, 0, 0}; // angles are turn_particles' (not stored here)
         vec3<Real> a, alpha;
-        accelerations<External>(p, i, kind, gravity, external, a, alpha);
+        accelerations<External>(p, i, kind, gravity, external, external_torque, a, alpha);
         Integrator::advance(pos, v, a, dt);
         Integrator::advance(angle, w, alpha, dt);
         if (!drifted) {
@@ -110,6 +117,7 @@ struct drift_particles {
     vec3<Real> gravity;
     Real dt;
     const vec3<Real>* external; ///< external force on each particle (N), read with External
+    const vec3<Real>* external_torque = nullptr; ///< external torque (N m), read with External unless null
 
     /// Particle i's position (wrapped) and velocity after the drift, from its fields now;
     /// nothing is stored (check_after_drift needs no more).
@@ -129,7 +137,7 @@ struct drift_particles {
         vec3<Real> v;
         drifted(i, pos, v);
         vec3<Real> w = p.omega[i], angle{0, 0, 0}, a, alpha; // angles are turn_particles' (not stored here)
-        accelerations<External>(p, i, static_cast<motion>(p.kind[i]), gravity, external, a, alpha);
+        accelerations<External>(p, i, static_cast<motion>(p.kind[i]), gravity, external, external_torque, a, alpha);
         Integrator::drift(angle, w, alpha, dt);
         p.x[i] = {pos.x, pos.y, pos.z, p.x[i].w};
         p.v[i] = v;

@@ -43,9 +43,10 @@
 
 namespace sphere {
 
-/// The checkpoint format version this build writes. It also reads version 4, which predates
-/// the contact-law interface and holds the linear law's parameters without the law's name.
-inline constexpr std::uint32_t checkpoint_format_version = 5;
+/// The checkpoint format version this build writes. It also reads version 5, which predates
+/// the bonds, and version 4, which predates the contact-law interface and holds the linear
+/// law's parameters without the law's name.
+inline constexpr std::uint32_t checkpoint_format_version = 6;
 
 /// The first 8 bytes of every checkpoint.
 inline constexpr char checkpoint_magic[9] = "SPHERECK";
@@ -344,6 +345,19 @@ std::string encode_checkpoint(const settings<Real, typename Law::template params
     e.array(s.x_at_build, put_v4);
     e.array(s.storage, put_u32);
 
+    // The bonds (format 6): their settings, then each bond's particles, state and last loads.
+    const bond_table<Real>& b = s.bonds;
+    e.params(config.bond);
+    e.u64(b.size());
+    e.array(b.i, put_u32);
+    e.array(b.j, put_u32);
+    e.array(b.rest, put_real);
+    e.array(b.shear, put_v4);
+    e.array(b.bend, put_v3);
+    e.array(b.broken, [](checkpoint_encoder& out, std::uint8_t v) { out.u8(v); });
+    for (const auto* field : {&b.released, &b.dissipated}) e.array(*field, put_real);
+    for (const auto* field : {&b.force, &b.torque_i, &b.torque_j}) e.array(*field, put_v3);
+
     const std::uint64_t payload = e.bytes.size() - detail::checkpoint_header_bytes;
     for (int k = 0; k < 8; ++k) e.bytes[16 + k] = static_cast<char>((payload >> (8 * k)) & 0xffu);
     e.u64(detail::fnv1a64(e.bytes.data(), e.bytes.size()));
@@ -371,11 +385,11 @@ checkpoint_data<Real, Law> decode_checkpoint(const std::string& bytes, const std
     const std::uint32_t version = head.u32("the format version");
     using params = typename Law::template params<Real>;
     constexpr bool linear_params = std::is_same_v<params, contact_params<Real>>;
-    if (version != checkpoint_format_version && !(version == 4 && linear_params))
-        detail::fail("checkpoint '", path, "': format version ", version, ", but this build reads version ",
-                     checkpoint_format_version, version == 4 ? " only for a contact law other than the linear one, "
-                                                               "which version 4 does not describe"
-                                                             : ", and 4 for the linear contact law");
+    if (version != checkpoint_format_version && version != 5 && !(version == 4 && linear_params))
+        detail::fail("checkpoint '", path, "': format version ", version, ", but this build reads versions ",
+                     checkpoint_format_version, " and 5", version == 4 ? ", and 4 only for the linear contact law, "
+                                                                       "which version 4 describes"
+                                                                     : ", and 4 for the linear contact law");
     const std::uint32_t precision = head.u32("the writer's precision");
     const std::uint64_t payload = head.u64("the payload size");
     if (payload > std::numeric_limits<std::uint64_t>::max() - header - tail)
@@ -501,6 +515,27 @@ checkpoint_data<Real, Law> decode_checkpoint(const std::string& bytes, const std
                                [](checkpoint_decoder& in) { return Real(in.f64("a history lane")); });
     st.x_at_build = d.array<vec4<Real>>("the positions at the last rebuild", n, 32, get_v4);
     st.storage = d.array<unsigned>("the storage order", n, 4, get_u32);
+    if (version >= 6) {
+        s.bond = d.params<bond_params<Real>>("settings.bond");
+        bond_table<Real>& b = st.bonds;
+        const std::uint64_t bonds = d.u64("the bond count");
+        b.i = d.array<unsigned>("the bonds' first particles", bonds, 4, get_u32);
+        b.j = d.array<unsigned>("the bonds' second particles", bonds, 4, get_u32);
+        b.rest = d.array<Real>("the bonds' rest lengths", bonds, 8, get_real);
+        b.shear = d.array<vec4<Real>>("the bonds' shear and twist", bonds, 32, get_v4);
+        b.bend = d.array<vec3<Real>>("the bonds' bending", bonds, 24, get_v3);
+        b.broken = d.array<std::uint8_t>("the bonds' broken flags", bonds, 1,
+                                         [](checkpoint_decoder& in) { return in.u8("a bond's broken flag"); });
+        b.released = d.array<Real>("the bonds' released energy", bonds, 8, get_real);
+        b.dissipated = d.array<Real>("the bonds' dissipated energy", bonds, 8, get_real);
+        b.force = d.array<vec3<Real>>("the bonds' forces", bonds, 24, get_v3);
+        b.torque_i = d.array<vec3<Real>>("the bonds' torques on i", bonds, 24, get_v3);
+        b.torque_j = d.array<vec3<Real>>("the bonds' torques on j", bonds, 24, get_v3);
+        for (std::size_t k = 0; k < bonds; ++k)
+            if (b.i[k] >= n || b.j[k] >= n || b.i[k] == b.j[k] || b.broken[k] > 1)
+                d.inconsistent("bond ", k, " joins particles ", b.i[k], " and ", b.j[k], " (", n,
+                               " particles) with broken flag ", unsigned(b.broken[k]), " (0 or 1)");
+    }
     if (d.left() != 0) d.inconsistent(d.left(), " bytes follow the last array");
     for (std::size_t i = 0; i < n; ++i)
         for (std::size_t e = t.begin(i); e < t.end(i); ++e) {

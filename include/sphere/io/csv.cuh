@@ -96,9 +96,9 @@ inline const char* wall_face_name(int f)
 /// Column names of the diagnostics row (diagnostics_row): time_s, kinetic_J, rotational_J,
 /// potential_J, elastic_J, dissipated_visc_J, dissipated_fric_J, boundary_work_J, total_J, then
 /// for each active wall face (in face order) wall_<face>_position_m, wall_<face>_velocity_m/s
-/// and wall_<face>_force_N.
+/// and wall_<face>_force_N; with `bonds`, then bond_elastic_J, bond_broken_J and broken_bonds.
 template <class Real>
-std::vector<std::string> diagnostics_columns(const wall_set<Real>& walls)
+std::vector<std::string> diagnostics_columns(const wall_set<Real>& walls, bool bonds = false)
 {
     std::vector<std::string> c = {"time_s",           "kinetic_J",         "rotational_J",
                                   "potential_J",      "elastic_J",         "dissipated_visc_J",
@@ -110,12 +110,16 @@ std::vector<std::string> diagnostics_columns(const wall_set<Real>& walls)
         c.push_back(w + "_velocity_m/s");
         c.push_back(w + "_force_N");
     }
+    if (bonds)
+        for (const char* name : {"bond_elastic_J", "bond_broken_J", "broken_bonds"}) c.push_back(name);
     return c;
 }
 
-/// The diagnostics of a simulation now, matching diagnostics_columns(sim.walls()): time (s),
-/// the energy budget (J, sim.energy(), total = energy().total()) and, for each active wall
-/// face, its position (m), velocity (m/s) along its axis and the particles' force on it (N).
+/// The diagnostics of a simulation now, matching diagnostics_columns(sim.walls(), a simulation
+/// with bonds): time (s), the energy budget (J, sim.energy(), total = energy().total()), for
+/// each active wall face its position (m), velocity (m/s) along its axis and the particles'
+/// force on it (N), and for a simulation with bonds the energy they hold and released (J) and
+/// how many have broken.
 template <class Sim>
 std::vector<double> diagnostics_row(const Sim& sim)
 {
@@ -135,6 +139,11 @@ std::vector<double> diagnostics_row(const Sim& sim)
         row.push_back(double(w.velocity));
         row.push_back(double(w.force));
     }
+    if (sim.bond_count()) {
+        row.push_back(double(e.bond_elastic));
+        row.push_back(double(e.bond_broken));
+        row.push_back(double(sim.broken_bonds()));
+    }
     return row;
 }
 
@@ -142,7 +151,7 @@ std::vector<double> diagnostics_row(const Sim& sim)
 template <class Sim>
 csv_series diagnostics_series(const std::string& path, const Sim& sim)
 {
-    return csv_series(path, diagnostics_columns(sim.walls()));
+    return csv_series(path, diagnostics_columns(sim.walls(), sim.bond_count() > 0));
 }
 
 } // namespace sphere

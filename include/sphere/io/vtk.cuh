@@ -25,6 +25,8 @@
 #include <filesystem>
 
 #include "../core/error.cuh"
+#include "../bonds/bond_table.cuh"
+#include "../boundary/world.cuh"
 #include "../core/vec.cuh"
 #include "../particles/state.cuh"
 #include "atomic_file.cuh"
@@ -108,6 +110,29 @@ void vtk_vectors(std::ostream& out, const char* name, const std::vector<vec3<Rea
     for (const vec3<Real>& v : values) out << "          " << v.x << ' ' << v.y << ' ' << v.z << '\n';
     out << "        </DataArray>\n";
 }
+
+/// The start of a .vtu file up to its points: the time `time` (s) as field data, a piece of
+/// the snapshot's particle centres as points (m) and `cells` cells.
+template <class Real>
+void vtu_points(std::ostream& out, const particle_snapshot<Real>& p, double time, std::size_t cells)
+{
+    const std::size_t n = p.size();
+    out << "<?xml version=\"1.0\"?>\n"
+        << "<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
+        << "  <UnstructuredGrid>\n"
+        << "    <FieldData>\n"
+        << "      <DataArray type=\"Float64\" Name=\"TimeValue\" NumberOfTuples=\"1\" format=\"ascii\">"
+        << std::setprecision(17) << time << std::setprecision(std::numeric_limits<Real>::max_digits10)
+        << "</DataArray>\n"
+        << "    </FieldData>\n"
+        << "    <Piece NumberOfPoints=\"" << n << "\" NumberOfCells=\"" << cells << "\">\n"
+        << "      <Points>\n"
+        << "        <DataArray type=\"" << vtk_float_type<Real>()
+        << "\" Name=\"position\" NumberOfComponents=\"3\" format=\"ascii\">\n";
+    for (std::size_t i = 0; i < n; ++i) out << "          " << p.x[i].x << ' ' << p.x[i].y << ' ' << p.x[i].z << '\n';
+    out << "        </DataArray>\n"
+        << "      </Points>\n";
+}
 } // namespace detail
 
 /// The text of a .vtu file (VTK XML UnstructuredGrid, ASCII) holding the particles of a
@@ -117,22 +142,8 @@ std::string vtu_text(const particle_snapshot<Real>& p, double time)
 {
     const std::size_t n = p.size();
     std::ostringstream out = detail::number_stream(std::numeric_limits<Real>::max_digits10);
-    out << "<?xml version=\"1.0\"?>\n"
-        << "<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
-        << "  <UnstructuredGrid>\n"
-        << "    <FieldData>\n"
-        << "      <DataArray type=\"Float64\" Name=\"TimeValue\" NumberOfTuples=\"1\" format=\"ascii\">"
-        << std::setprecision(17) << time << std::setprecision(std::numeric_limits<Real>::max_digits10)
-        << "</DataArray>\n"
-        << "    </FieldData>\n"
-        << "    <Piece NumberOfPoints=\"" << n << "\" NumberOfCells=\"" << n << "\">\n"
-        << "      <Points>\n"
-        << "        <DataArray type=\"" << detail::vtk_float_type<Real>()
-        << "\" Name=\"position\" NumberOfComponents=\"3\" format=\"ascii\">\n";
-    for (std::size_t i = 0; i < n; ++i) out << "          " << p.x[i].x << ' ' << p.x[i].y << ' ' << p.x[i].z << '\n';
-    out << "        </DataArray>\n"
-        << "      </Points>\n"
-        << "      <Cells>\n"
+    detail::vtu_points(out, p, time, n);
+    out << "      <Cells>\n"
         << "        <DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n";
     for (std::size_t i = 0; i < n; ++i) out << "          " << i << '\n';
     out << "        </DataArray>\n"
@@ -187,6 +198,59 @@ template <class Sim>
 void write_vtu(const std::string& path, const Sim& sim)
 {
     write_vtu(path, sim.snapshot(), sim.time());
+}
+
+/// The text of a .vtu file holding the bonds of a snapshot at time `time` (s): the particle
+/// centres as points (m) and each intact bond as a line cell (VTK_LINE) from its particle i to
+/// its particle j; cell data bond (its index in the bond table), stretch (m, the distance of
+/// its centres, the nearest image in `box`, less its rest length) and force (N, on particle i).
+template <class Real>
+std::string bonds_vtu_text(const particle_snapshot<Real>& p, const bond_table<Real>& b, const world<Real>& box,
+                           double time)
+{
+    std::vector<std::size_t> intact;
+    for (std::size_t k = 0; k < b.size(); ++k)
+        if (!b.broken[k]) intact.push_back(k);
+    std::ostringstream out = detail::number_stream(std::numeric_limits<Real>::max_digits10);
+    detail::vtu_points(out, p, time, intact.size());
+    out << "      <Cells>\n"
+        << "        <DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n";
+    for (std::size_t k : intact) out << "          " << b.i[k] << ' ' << b.j[k] << '\n';
+    out << "        </DataArray>\n"
+        << "        <DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n";
+    for (std::size_t c = 0; c < intact.size(); ++c) out << "          " << 2 * (c + 1) << '\n';
+    out << "        </DataArray>\n"
+        << "        <DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n";
+    for (std::size_t c = 0; c < intact.size(); ++c) out << "          3\n"; // VTK_LINE
+    out << "        </DataArray>\n"
+        << "      </Cells>\n"
+        << "      <CellData Scalars=\"stretch\" Vectors=\"force\">\n"
+        << "        <DataArray type=\"Int64\" Name=\"bond\" format=\"ascii\">\n";
+    for (std::size_t k : intact) out << "          " << k << '\n';
+    out << "        </DataArray>\n";
+    std::vector<Real> stretch;
+    std::vector<vec3<Real>> force;
+    for (std::size_t k : intact) {
+        stretch.push_back(Real(std::sqrt(double(norm2(box.nearest_image_inside(p.position(b.i[k]) - p.position(b.j[k]))))) -
+                                double(b.rest[k])));
+        force.push_back(b.force[k]);
+    }
+    detail::vtk_scalars(out, "stretch", stretch);
+    detail::vtk_vectors(out, "force", force);
+    out << "      </CellData>\n"
+        << "    </Piece>\n"
+        << "  </UnstructuredGrid>\n"
+        << "</VTKFile>\n";
+    return out.str();
+}
+
+/// Writes the bonds of a simulation at its current time to the .vtu file `path`, atomically
+/// (bonds_vtu_text; a bond across a periodic boundary is drawn between the two centres as
+/// stored, across the box). Throws sphere::error naming the file when it cannot be written.
+template <class Sim>
+void write_bonds_vtu(const std::string& path, const Sim& sim)
+{
+    write_file_atomically(path, bonds_vtu_text(sim.snapshot(), sim.bonds(), sim.config().box, sim.time()));
 }
 
 /// A ParaView collection file (.pvd): a list of (time, data file) entries. Every add()
