@@ -36,3 +36,12 @@ add_test(NAME plot_series
 set_tests_properties(plot_series PROPERTIES
     LABELS plot
     TIMEOUT 120)
+
+# scripts/plot_bond_rose.py: the bonds' rose from a bonds VTK file (tests/test_plot_bond_rose.py
+# writes such files, checks the angles, the figure and the errors).
+add_test(NAME plot_bond_rose
+    COMMAND "${SPHERE_VTK_PYTHON}" "${CMAKE_CURRENT_LIST_DIR}/test_plot_bond_rose.py"
+            "${PROJECT_SOURCE_DIR}/scripts/plot_bond_rose.py")
+set_tests_properties(plot_bond_rose PROPERTIES
+    LABELS plot
+    TIMEOUT 120)

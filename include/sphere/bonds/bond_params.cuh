@@ -4,7 +4,6 @@
 /// the springs, dashpots and strengths they give a bond between two radii.
 #include <cmath>
 #include <limits>
-#include <utility>
 
 #include "../core/config.cuh"
 #include "../core/constants.cuh"
@@ -51,8 +50,11 @@ void validate_bond_params(const bond_params<Real>& b)
     finite("k_n", b.k_n, " Pa/m", false);
     finite("k_t", b.k_t, " Pa/m", false);
     finite("damping", b.damping, "", false);
-    for (const auto& [name, v] : {std::pair{"tensile_strength", b.tensile_strength}, std::pair{"shear_strength", b.shear_strength}})
-        if (!(v > 0)) detail::fail("settings.bond.", name, " = ", v, " Pa: must be positive (infinity: unbreakable)");
+    const char* names[2] = {"tensile_strength", "shear_strength"};
+    const Real strengths[2] = {b.tensile_strength, b.shear_strength};
+    for (int k = 0; k < 2; ++k)
+        if (!(strengths[k] > 0))
+            detail::fail("settings.bond.", names[k], " = ", strengths[k], " Pa: must be positive (infinity: unbreakable)");
 }
 
 /// A bond's springs (N/m, N m/rad), the geometry of its disc and its dashpots, for two radii

@@ -202,8 +202,9 @@ void write_vtu(const std::string& path, const Sim& sim)
 
 /// The text of a .vtu file holding the bonds of a snapshot at time `time` (s): the particle
 /// centres as points (m) and each intact bond as a line cell (VTK_LINE) from its particle i to
-/// its particle j; cell data bond (its index in the bond table), stretch (m, the distance of
-/// its centres, the nearest image in `box`, less its rest length) and force (N, on particle i).
+/// its particle j; cell data bond (its index in the bond table), axis (m, from i's centre to
+/// j's, the nearest image in `box`), stretch (m, the axis' length less the rest length) and
+/// force (N, on particle i).
 template <class Real>
 std::string bonds_vtu_text(const particle_snapshot<Real>& p, const bond_table<Real>& b, const world<Real>& box,
                            double time)
@@ -229,12 +230,13 @@ std::string bonds_vtu_text(const particle_snapshot<Real>& p, const bond_table<Re
     for (std::size_t k : intact) out << "          " << k << '\n';
     out << "        </DataArray>\n";
     std::vector<Real> stretch;
-    std::vector<vec3<Real>> force;
+    std::vector<vec3<Real>> axis, force;
     for (std::size_t k : intact) {
-        stretch.push_back(Real(std::sqrt(double(norm2(box.nearest_image_inside(p.position(b.i[k]) - p.position(b.j[k]))))) -
-                                double(b.rest[k])));
+        axis.push_back(box.nearest_image_inside(p.position(b.j[k]) - p.position(b.i[k])));
+        stretch.push_back(Real(std::sqrt(double(norm2(axis.back()))) - double(b.rest[k])));
         force.push_back(b.force[k]);
     }
+    detail::vtk_vectors(out, "axis", axis);
     detail::vtk_scalars(out, "stretch", stretch);
     detail::vtk_vectors(out, "force", force);
     out << "      </CellData>\n"
