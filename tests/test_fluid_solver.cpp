@@ -13,6 +13,7 @@
 #include <sphere/fluid.cuh>
 
 #include <cmath>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -226,6 +227,9 @@ TEMPLATE_TEST_CASE("the fluid solver refuses unstable time steps, unconverged so
     bad.top = sphere::fluid_boundary<Real>::prescribed_pressure(0);
     const auto flat = column_grid<Real>(4, 4, 2, Real(0.4), Real(0.4), Real(0.2));
     CHECK_THROWS_WITH((sphere::navier_stokes<Real, sphere::host>(flat, bad)), Catch::Contains("nz = 2"));
+    bad = {};
+    bad.top = sphere::fluid_boundary<Real>::prescribed_pressure(std::numeric_limits<Real>::quiet_NaN());
+    CHECK_THROWS_WITH((sphere::navier_stokes<Real, sphere::host>(g, bad)), Catch::Contains("fluid: top.pressure = nan Pa is not finite"));
 }
 
 TEST_CASE("Jacobi and conjugate gradients give the same flow", "[fluid]")

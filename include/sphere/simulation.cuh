@@ -38,22 +38,31 @@ namespace sphere {
 
 namespace detail {
 /// The power (W) of the agent that keeps prescribed particle i on its course, after
-/// integration. The agent cancels whatever the contacts and gravity would change: its force is
-/// m a - f - m g and its torque -t (a = 0 for motion::prescribed, a = f_z / m along z for
-/// motion::prescribed_horizontal), and its power is their product with the velocities at the
-/// positions' time (docs/physics.md, "Driven particles").
+/// integration. The agent cancels whatever the contacts, the bonds and gravity would change:
+/// its force is m a - f - m g and its torque -t (f and t of the contacts and bonds; a = 0 for
+/// motion::prescribed, a = f_z / m along z for motion::prescribed_horizontal), and its power is
+/// their product with the velocities at the positions' time (docs/physics.md, "Driven
+/// particles").
 template <class P>
 struct drive_power {
     using Real = real_t<P>;
     particle_view<P> p;
     vec3<Real> gravity;
+    const vec3<Real>* loads = nullptr;       ///< with bonds: their loads plus the external force
+    const vec3<Real>* load_torques = nullptr; ///< with bonds: their torques
+    const vec3<Real>* external = nullptr;    ///< the external forces in `loads` (not the agent's to cancel), or null
     SPHERE_HD double operator()(std::size_t i) const
     {
         const auto kind = static_cast<motion>(p.kind[i]);
         if (kind != motion::prescribed && kind != motion::prescribed_horizontal) return 0;
-        vec3<Real> agent = -(p.force[i] + gravity * p.mass[i]);
+        vec3<Real> force = p.force[i], torque = p.torque[i];
+        if (loads) {
+            force += loads[i] - (external ? external[i] : vec3<Real>{0, 0, 0});
+            torque += load_torques[i];
+        }
+        vec3<Real> agent = -(force + gravity * p.mass[i]);
         if (kind == motion::prescribed_horizontal) agent.z = -gravity.z * p.mass[i];
-        return double(dot(agent, p.v_sync[i])) - double(dot(p.torque[i], p.omega_sync[i]));
+        return double(dot(agent, p.v_sync[i])) - double(dot(torque, p.omega_sync[i]));
     }
 };
 
@@ -634,13 +643,22 @@ public:
     {
         if (s.particles.size() != size())
             detail::fail("restore: the state holds ", s.particles.size(), " particles, the simulation ", size());
+        const particle_snapshot<Coord>& q = s.particles;
+        const char* names[15] = {"v",      "omega",  "v_sync", "omega_sync", "angpos", "force", "torque", "mass",
+                                 "pressure", "e_visc", "e_fric", "p_visc",     "p_fric", "kind",  "material"};
+        const std::size_t counts[15] = {q.v.size(),      q.omega.size(),  q.v_sync.size(), q.omega_sync.size(),
+                                        q.angpos.size(), q.force.size(),  q.torque.size(), q.mass.size(),
+                                        q.pressure.size(), q.e_visc.size(), q.e_fric.size(), q.p_visc.size(),
+                                        q.p_fric.size(), q.kind.size(),   q.material.size()};
+        for (int k = 0; k < 15; ++k)
+            if (counts[k] != size())
+                detail::fail("restore: the state's particles.", names[k], " holds ", counts[k], " values for ", size(),
+                             " particles");
         for (std::size_t i = 0; i < size(); ++i)
             if (s.particles.kind[i] > last_motion)
                 detail::fail("restore: particle ", i, " has motion kind ", unsigned(s.particles.kind[i]), ", at most ",
                              unsigned(last_motion), " is valid");
         for (std::size_t i = 0; i < size(); ++i) kinds_[i] = static_cast<motion>(s.particles.kind[i]);
-        if (s.particles.material.size() != size())
-            detail::fail("restore: the state holds ", s.particles.material.size(), " materials for ", size(), " particles");
         for (std::size_t i = 0; i < size(); ++i) check_material(i, s.particles.material[i], "restore: ");
         if (s.x_at_build.size() != size())
             detail::fail("restore: the state holds ", s.x_at_build.size(), " build positions for ", size(), " particles");
@@ -896,7 +914,11 @@ private:
             if constexpr (!drifted) turn(halt);
             if (drive_)
                 transform_reduce_into(context_, n,
-                                      detail::by_rank<detail::drive_power<Precision>, Real>{{p, gravity_}, lists_.view()},
+                                      detail::by_rank<detail::drive_power<Precision>, Real>{
+                                          {p, gravity_, bonds_.size() ? load_force_.data() : nullptr,
+                                           bonds_.size() ? load_torque_.data() : nullptr,
+                                           external_.size() ? external_.data() : nullptr},
+                                          lists_.view()},
                                       0.0, plus_op{}, &report->drive_power);
             context_.read_back(&done, report, 1,
                                "the step's report (wall loads, particle check, drive power, list totals)", steps_ + 1);
@@ -1104,10 +1126,11 @@ private:
     [[noreturn]] void report_bad_particle(std::size_t i, std::size_t step) const
     {
         const particle_snapshot<Coord> s = particles_.snapshot();
-        const vec3<Coord> x = s.position(i), v = s.v_sync[i];
+        const vec3<Coord> x = s.position(i), v = s.v_sync[i], w = s.omega_sync[i];
         if (!isfinite(x) || !isfinite(v) || !isfinite(s.omega_sync[i]))
             detail::fail("step ", step, ": particle ", i, " became non-finite (position (", x.x, ", ", x.y, ", ",
-                         x.z, ") m, velocity (", v.x, ", ", v.y, ", ", v.z, ") m/s); reduce the time step");
+                         x.z, ") m, velocity (", v.x, ", ", v.y, ", ", v.z, ") m/s, angular velocity (", w.x, ", ",
+                         w.y, ", ", w.z, ") rad/s); reduce the time step");
         detail::fail("step ", step, ": particle ", i, " left the world: position (", x.x, ", ", x.y, ", ", x.z,
                      ") m, world [", settings_.box.lo.x, ", ", settings_.box.hi.x, "] x [", settings_.box.lo.y, ", ",
                      settings_.box.hi.y, "] x [", settings_.box.lo.z, ", ", settings_.box.hi.z,

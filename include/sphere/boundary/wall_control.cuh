@@ -46,6 +46,9 @@ void validate_wall_controls(const wall_control<Real> (&controls)[wall_set<Real>:
 {
     for (int f = 0; f < wall_set<Real>::count; ++f) {
         const wall_control<Real>& c = controls[f];
+        if (static_cast<unsigned>(c.mode) > static_cast<unsigned>(wall_mode::stress))
+            detail::fail("settings.walls[", f, "].mode = ", static_cast<unsigned>(c.mode),
+                         ": not a wall_mode (0 fixed, 1 velocity, 2 stress)");
         if (c.mode == wall_mode::fixed) continue;
         if (box.periodic(f / 2))
             detail::fail("settings.walls[", f, "]: axis ", f / 2, " is periodic, so face ", f, " has no wall to move");

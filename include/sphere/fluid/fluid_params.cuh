@@ -67,9 +67,12 @@ struct fluid_params {
         const char* names[2] = {"bottom", "top"};
         for (int e = 0; e < 2; ++e) {
             const auto& b = *ends[e];
-            if (!std::isfinite(b.pressure) || !std::isfinite(b.amplitude) || !std::isfinite(b.frequency) ||
-                !std::isfinite(b.phase))
-                detail::fail("fluid: the ", names[e], " boundary has a non-finite pressure, amplitude, frequency or phase");
+            const Real values[4] = {b.pressure, b.amplitude, b.frequency, b.phase};
+            const char* fields[4] = {"pressure", "amplitude", "frequency", "phase"};
+            const char* units[4] = {" Pa", " Pa", " Hz", " rad"};
+            for (int k = 0; k < 4; ++k)
+                if (!std::isfinite(values[k]))
+                    detail::fail("fluid: ", names[e], ".", fields[k], " = ", values[k], units[k], " is not finite");
             if (b.frequency < 0)
                 detail::fail("fluid: the ", names[e], " boundary frequency = ", b.frequency, " Hz is negative");
         }

@@ -70,7 +70,8 @@ struct grid_geometry {
     static grid_geometry make(const world<Real>& box, Real reach, Real requested)
     {
         if (requested > 0 && requested < reach)
-            detail::fail("settings.cell_size = ", requested, " m is smaller than the largest particle diameter plus skin, ",
+            detail::fail("settings.cell_size = ", requested,
+                         " m is smaller than the largest particle diameter plus skin and the contact law's range, ",
                          reach, " m: contacts would be missed");
         const Real target = requested > 0 ? requested : reach;
         grid_geometry g;

@@ -62,10 +62,14 @@ public:
                          " m: need 0 < radius_min <= radius_max, finite");
         if (!(s.density > 0) || !std::isfinite(s.density))
             detail::fail("insertion_settings.density = ", s.density, " kg/m^3: must be positive and finite");
-        for (int a = 0; a < 3; ++a)
+        for (int a = 0; a < 3; ++a) {
+            if (!std::isfinite(s.lo[a]) || !std::isfinite(s.hi[a]))
+                detail::fail("insertion_settings: the region spans [", s.lo[a], ", ", s.hi[a], "] m on axis ", a,
+                             ": its bounds must be finite");
             if (!(s.hi[a] - s.lo[a] >= 2 * s.radius_max))
                 detail::fail("insertion_settings: the region spans [", s.lo[a], ", ", s.hi[a], "] m on axis ", a,
                              ", too little for a particle of radius ", s.radius_max, " m");
+        }
         if (s.tries == 0) detail::fail("insertion_settings.tries = 0: at least one candidate is needed");
         if (s.distribution == radius_distribution::lognormal) {
             if (!(s.radius_mean >= s.radius_min && s.radius_mean <= s.radius_max))

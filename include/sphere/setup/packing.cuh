@@ -107,7 +107,7 @@ std::vector<vec3<Real>> random_packing(const std::vector<Real>& radii, const wor
         if (!std::isfinite(region.lo[a]) || !std::isfinite(region.hi[a]) || !(region.hi[a] > region.lo[a]))
             detail::fail("random_packing: region axis ", a, " spans [", region.lo[a], ", ", region.hi[a],
                          "] m; it must be finite with hi > lo");
-    if (!(gap >= 0) || !std::isfinite(gap)) detail::fail("random_packing: gap = ", gap, " m must be non-negative");
+    if (!(gap >= 0) || !std::isfinite(gap)) detail::fail("random_packing: gap = ", gap, " m must be non-negative and finite");
     if (max_tries == 0) detail::fail("random_packing: max_tries = 0: at least one try is needed");
     const std::size_t n = radii.size();
     double r_max = 0;
