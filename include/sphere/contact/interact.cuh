@@ -276,36 +276,50 @@ struct slab_phases {
     }
 };
 
+/// Thread t of `threads` in the slab schedule (sum_by_slabs): its share of the zeroing, of
+/// each phase's tasks and of the finish. The work-sharing loop and the barriers bind to the
+/// enclosing parallel region, or, called outside one, to a team of one.
+template <class Pairs, class Zero, class Finish>
+void slab_share(const Pairs& pairs, const Zero& zero, const Finish& finish, std::size_t n,
+                const std::vector<unsigned>& layer_start, const slab_phases& phases, int threads, int t)
+{
+    const long long count = static_cast<long long>(n);
+#pragma omp for schedule(static)
+    for (long long i = 0; i < count; ++i) zero(static_cast<std::size_t>(i));
+    for (int ph = 0; ph < 2; ++ph) {
+        std::size_t first, end;
+        phases.share(ph, t, threads, first, end);
+        for (std::size_t k = first; k < end; ++k) {
+            const slab_phases::task& task = phases.phase[ph][k];
+            for (unsigned m = 0; m < task.layers; ++m)
+                pairs(layer_start[task.layer[m]], layer_start[task.layer[m] + 1]);
+        }
+#pragma omp barrier
+    }
+    unsigned lo, hi;
+    phases.block(t, threads, lo, hi);
+    finish(layer_start[lo], layer_start[hi], t);
+}
+
 /// Runs the slab schedule on the host: zeroes the sums, then the two phases, each thread
 /// working through its share of a phase's tasks, then `finish(first_rank, end_rank, thread)`
-/// for the ranks of the thread's block of layers.
+/// for the ranks of the thread's block of layers. Few particles, or a team of one, run
+/// without an OpenMP region (see for_each_index).
 template <class Pairs, class Zero, class Finish>
 void sum_by_slabs(const Pairs& pairs, const Zero& zero, const Finish& finish, std::size_t n,
                   const std::vector<unsigned>& layer_start, const slab_phases& phases)
 {
-    const long long count = static_cast<long long>(n);
-#pragma omp parallel if (n >= host_parallel_threshold) num_threads(host_team())
+    if (n < host_parallel_threshold || host_team() == 1) {
+        slab_share(pairs, zero, finish, n, layer_start, phases, 1, 0);
+        return;
+    }
+#pragma omp parallel num_threads(host_team())
     {
 #ifdef _OPENMP
-        const int threads = omp_get_num_threads(), t = omp_get_thread_num();
+        slab_share(pairs, zero, finish, n, layer_start, phases, omp_get_num_threads(), omp_get_thread_num());
 #else
-        const int threads = 1, t = 0;
+        slab_share(pairs, zero, finish, n, layer_start, phases, 1, 0);
 #endif
-#pragma omp for schedule(static)
-        for (long long i = 0; i < count; ++i) zero(static_cast<std::size_t>(i));
-        for (int ph = 0; ph < 2; ++ph) {
-            std::size_t first, end;
-            phases.share(ph, t, threads, first, end);
-            for (std::size_t k = first; k < end; ++k) {
-                const slab_phases::task& task = phases.phase[ph][k];
-                for (unsigned m = 0; m < task.layers; ++m)
-                    pairs(layer_start[task.layer[m]], layer_start[task.layer[m] + 1]);
-            }
-#pragma omp barrier
-        }
-        unsigned lo, hi;
-        phases.block(t, threads, lo, hi);
-        finish(layer_start[lo], layer_start[hi], t);
     }
 }
 

@@ -63,8 +63,7 @@ T host_reduce(std::size_t n, const Transform& f, T init, Op op, T* partial)
 {
     const std::size_t chunks = host_reduce_chunks(n);
     const long long count = static_cast<long long>(chunks);
-#pragma omp parallel for schedule(static) if (chunks > 1) num_threads(host_team())
-    for (long long c = 0; c < count; ++c) {
+    const auto chunk = [&](long long c) {
         Transform local = f; // see detail::run_chunk
         const std::size_t begin = static_cast<std::size_t>(c) * host_chunk;
         const std::size_t end = begin + host_chunk < n ? begin + host_chunk : n;
@@ -78,6 +77,12 @@ T host_reduce(std::size_t n, const Transform& f, T init, Op op, T* partial)
             for (std::size_t i = begin + 1; i < end; ++i) acc = op(acc, local(i));
         }
         partial[static_cast<std::size_t>(c)] = acc;
+    };
+    if (chunks > 1 && host_team() > 1) { // else no OpenMP region at all (see for_each_index)
+#pragma omp parallel for schedule(static) num_threads(host_team())
+        for (long long c = 0; c < count; ++c) chunk(c);
+    } else {
+        for (long long c = 0; c < count; ++c) chunk(c);
     }
     T result = init;
     for (std::size_t c = 0; c < chunks; ++c) result = op(result, partial[c]);

@@ -41,11 +41,22 @@ void run_chunk(const Body& body, std::size_t begin, std::size_t end)
 /// Static schedule: each thread takes the same share of every loop, so a particle's data stay
 /// in one core's cache from loop to loop (a dynamic schedule measured 17% slower on the bed
 /// with 2 threads, docs/performance.md).
+///
+/// A loop too short for threads, or a team of one, runs without entering an OpenMP region: a
+/// region of one thread still costs libgomp's team start and end (system calls that took 40%
+/// of a 6-particle step).
 template <class Body>
 void for_each_index(host, std::size_t n, const Body& body)
 {
     const long long chunks = static_cast<long long>((n + host_chunk - 1) / host_chunk);
-#pragma omp parallel for schedule(static) if (n >= host_parallel_threshold) num_threads(host_team())
+    if (n < host_parallel_threshold || host_team() == 1) {
+        for (long long c = 0; c < chunks; ++c) {
+            const std::size_t begin = static_cast<std::size_t>(c) * host_chunk;
+            detail::run_chunk(body, begin, begin + host_chunk < n ? begin + host_chunk : n);
+        }
+        return;
+    }
+#pragma omp parallel for schedule(static) num_threads(host_team())
     for (long long c = 0; c < chunks; ++c) {
         const std::size_t begin = static_cast<std::size_t>(c) * host_chunk;
         detail::run_chunk(body, begin, begin + host_chunk < n ? begin + host_chunk : n);
