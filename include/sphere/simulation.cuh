@@ -875,6 +875,8 @@ private:
                                                                             external, external_torque};
         detail::step_report<Coord>* report = report_.data(); // policy memory
         const unsigned* halt = &report->lists.overflow;
+        // The drift's loads: the bonds' of the last step with the external forces written since.
+        if (drifted && bonds_.size() && external_.size()) bond_loads(nullptr);
         if constexpr (drifted) {
             // The last step's report checked the positions this drift gives (check_after_drift),
             // unless the host has changed something the drift reads since: then the drift
@@ -892,7 +894,6 @@ private:
         // From here the step may run twice: when its rebuild overflows the lists' capacities,
         // nothing that lasts changes (the bodies see *halt), the capacities grow and it runs
         // again, to the same bits as with room from the start.
-        if (drifted && bonds_.size() && external_.size()) bond_loads(nullptr); // the external forces of now
         const bool rebuild = needs_rebuild_;
         detail::step_report<Coord> done{};
         do {
