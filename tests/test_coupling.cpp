@@ -7,6 +7,9 @@
 //   and phi times Ergun when the pressure force is not exchanged;
 // - F10: particles moving through a fluid at rest exchange x-momentum with it, conserving the
 //   total within 1%, and share the common final velocity;
+// - hindered settling in a closed box: the fluid's flux through mid-height equals the
+//   particles' volume flux through it (the porosity conserves the solid volume), and the
+//   settling velocity is steady;
 // - a coupled run is bit-identical when repeated with the same thread count;
 // - a fluid step longer than a particle's response time is refused.
 #include <catch2/catch.hpp>
@@ -17,7 +20,9 @@
 #include <omp.h>
 
 #include <cmath>
+#include <algorithm>
 #include <cstring>
+#include <random>
 #include <vector>
 
 namespace {
@@ -228,14 +233,14 @@ TEMPLATE_TEST_CASE("F10: particles and fluid exchange x-momentum and conserve it
     }
     INFO("largest relative change of the total x-momentum " << worst);
     CHECK(worst < 0.01);
-    // The particles end near the common velocity M_p v0 / (M_p + M_f) = 2.8140e-3 m/s
-    // (VALIDATION F10): within 5%, because on this coarse grid (5 particle diameters per cell)
-    // the cell-sphere porosity does not translate exactly with the particles, which keeps a small
-    // slip between them and the fluid (measured: 3% above the common velocity).
+    // The particles end at the common velocity M_p v0 / (M_p + M_f) = 2.8140e-3 m/s
+    // (VALIDATION F10; measured -0.04%). The seeds' cell-sphere porosity, which on this coarse
+    // grid (5 particle diameters per cell) does not translate exactly with the particles, kept
+    // a slip of 3% between them and the fluid; the default cell_volume porosity moves with them.
     const auto snap = sim.snapshot();
     double v_mean = 0;
     for (std::size_t i = 0; i < snap.size(); ++i) v_mean += double(snap.v[i].x) / double(snap.size());
-    CHECK(v_mean == Approx(2.8140e-3).epsilon(0.05));
+    CHECK(v_mean == Approx(2.8140e-3).epsilon(0.005));
     CHECK(v_mean < 0.5 * v0);
 }
 
@@ -302,4 +307,122 @@ TEST_CASE("a coupled run repeats bit-identically with the same thread count", "[
     CHECK(std::memcmp(a.second.data(), b.second.data(), a.second.size() * sizeof(Real)) == 0);
     // The particles did move through the fluid.
     CHECK(double(a.first.v[0].z) < -1e-3);
+}
+
+namespace {
+/// The volume (m^3) of the parts of the particles of `snap` that lie below the plane z = h:
+/// each sphere's cross-section pi (r^2 - z^2) integrated by Simpson's rule (exact for it).
+template <class Real>
+double volume_below(const sphere::particle_snapshot<Real>& snap, double h)
+{
+    double v = 0;
+    for (std::size_t i = 0; i < snap.size(); ++i) {
+        const double r = double(snap.x[i].w), z = double(snap.x[i].z);
+        const double a = -r, b = std::min(r, h - z);
+        if (!(b > a)) continue;
+        const auto area = [r](double t) { return pi * (r * r - t * t); };
+        v += (b - a) / 6 * (area(a) + 4 * area(0.5 * (a + b)) + area(b));
+    }
+    return v;
+}
+} // namespace
+
+TEMPLATE_TEST_CASE("hindered settling in a closed box: the fluid's flux through mid-height balances the particles'",
+                   "[coupling][slow]", float, double)
+{
+    using Real = TestType;
+    // 3000 particles d = 1 mm (rho_p = 2600) at random in a 20 x 20 x 40 mm box (porosity 0.90),
+    // periodic sides, no-flow bottom and top, mu = 0.1 Pa s, 8 x 8 x 16 fluid cells (2.5 d).
+    // The mixture is incompressible and the box closed, so the fluid's flux up through the
+    // plane at mid-height equals the particles' volume flux down through it, which the test
+    // measures independently: the particles' volume below the plane (volume_below) at the
+    // starts of two fluid steps, over the step. The porosity estimator conserves the solid
+    // volume (porosity_method::cell_volume), so the pressure solve's compatibility condition
+    // holds and no source spoils the balance: 1% is asked, round-off and the solver's tolerance
+    // are what remain (measured: 8e-11 in double, 5e-4 in float; the seeds' cell-sphere
+    // estimator misses by up to 149%, docs/fluid.md). And the settling velocity is steady: it rises
+    // from 5.6 to 6.3 mm/s over the first 0.1 s (ten times the particles' response time: the
+    // fluid's convection cells grow on the viscous time of a few cells) and then stays within 1%.
+    const double d = 1e-3, Lx = 0.02, Lz = 0.04, mu = 0.1;
+    sphere::settings<Real> s = periodic_column<Real>(Lx, Lx, Lz, 100);
+    s.gravity = {0, 0, Real(-9.81)};
+    s.skin = Real(0.1 * d);  // contact lists rebuilt every ~100 steps rather than every step
+    std::vector<sphere::particle<Real>> ps;
+    std::mt19937_64 gen(7);
+    std::uniform_real_distribution<double> u(0, 1);
+    while (ps.size() < 3000) {
+        const double x = Lx * u(gen), y = Lx * u(gen), z = d + (Lz - 2 * d) * u(gen);
+        bool free = true;
+        for (const auto& q : ps) {
+            double dx = double(q.position.x) - x, dy = double(q.position.y) - y, dz = double(q.position.z) - z;
+            dx -= Lx * std::nearbyint(dx / Lx);
+            dy -= Lx * std::nearbyint(dy / Lx);
+            if (dx * dx + dy * dy + dz * dz < 1.1 * d * 1.1 * d) {
+                free = false;
+                break;
+            }
+        }
+        if (!free) continue;
+        sphere::particle<Real> p;
+        p.position = {Real(x), Real(y), Real(z)};
+        p.radius = Real(d / 2);
+        p.density = 2600;
+        ps.push_back(p);
+    }
+    sim_t<Real> sim(s, ps);
+    sphere::fluid_params<Real> prm;
+    prm.density = 1000;
+    prm.viscosity = Real(mu);
+    prm.gravity = s.gravity;
+    prm.poisson.tolerance = sizeof(Real) == 8 ? 1e-10 : 1e-5;
+    sphere::coupling_options opt;
+    opt.dem_steps = unsigned(std::ceil(2e-4 / double(sim.dt())));
+    coupling_t<Real, sphere::drag::wen_yu> coupled(sphere::fluid_grid<Real>::make(s.box, 8, 8, 16), prm, opt);
+    const auto& grid = coupled.fluid().grid();
+    const double dt = double(opt.dem_steps) * double(sim.dt()), mid = Lz / 2, face = Lx * Lx / 64;
+
+    double below_previous = volume_below(sim.snapshot(), mid), worst = 0, flux_mean = 0;
+    int compared = 0;
+    std::vector<double> settling;  // mean v_z (m/s) of the particles in the middle half, every 10 steps
+    for (int n = 1; sim.time() < 0.14; ++n) {
+        const auto start = sim.snapshot();
+        const double below = volume_below(start, mid);
+        coupled.step(sim);
+        // Step n's fluid saw the porosity at its start against the one at the start of step n - 1.
+        const double particles = (below - below_previous) / dt;
+        below_previous = below;
+        const auto phi = coupled.fluid().porosity();
+        const auto w = coupled.fluid().face_velocity(2);
+        double fluid = 0;
+        for (int j = 0; j < 8; ++j)
+            for (int i = 0; i < 8; ++i) {
+                const std::size_t lo = grid.field_index(i, j, 7), hi = grid.field_index(i, j, 8);
+                fluid += 0.5 * (double(phi[lo]) + double(phi[hi])) * double(w[lo]) * face;
+            }
+        if (n >= 5) {
+            worst = std::max(worst, std::abs(fluid - particles) / std::abs(particles));
+            flux_mean += particles;
+            ++compared;
+        }
+        if (n % 10 == 0 && sim.time() > 0.1) {
+            double v = 0, count = 0;
+            for (std::size_t i = 0; i < start.size(); ++i)
+                if (std::abs(double(start.x[i].z) - mid) < Lz / 4) {
+                    v += double(start.v[i].z);
+                    count += 1;
+                }
+            settling.push_back(v / count);
+        }
+    }
+    flux_mean /= compared;
+    INFO("particle volume flux down through mid-height " << flux_mean << " m^3/s on average; largest relative difference "
+                                                          << "of the fluid's flux up from it " << worst);
+    CHECK(flux_mean > 1e-7);
+    CHECK(worst < 0.01);
+    double v_mean = 0, v_spread = 0;
+    for (double v : settling) v_mean += v / double(settling.size());
+    for (double v : settling) v_spread = std::max(v_spread, std::abs(v - v_mean));
+    INFO("settling velocity " << v_mean << " m/s over " << settling.size() << " samples, largest departure " << v_spread);
+    CHECK(v_mean < -1e-3);
+    CHECK(v_spread < 0.02 * std::abs(v_mean));
 }

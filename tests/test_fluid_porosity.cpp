@@ -8,7 +8,11 @@
 //   cells on a void and on a particle, two cell widths, with walls and across periodic
 //   boundaries;
 // - the lens-weighted particle velocity and diameter, dphi/dt by backward Euler, the cell
-//   sphere of non-cubic cells, the binned particle search against a brute-force sum;
+//   sphere of non-cubic cells, the binned particle search against a brute-force sum (these for
+//   the seeds' cell-sphere estimator, porosity_method::cell_sphere);
+// - porosity_method::cell_volume (the default): against a brute-force sum, the grid's and each
+//   layer's solid volume conserved exactly (with particles across faces, periodic boundaries
+//   and walls), a lattice's porosity wherever it sits, rates that sum to zero;
 // - the grid's index spaces and the errors for bad input.
 #include <catch2/catch.hpp>
 
@@ -242,7 +246,7 @@ TEMPLATE_TEST_CASE("F2: one particle at the cell centre, r/R = 0.2, gives phi = 
     const auto g = sphere::fluid_grid<Real>::make(make_box<Real>({0, 0, 0}, {1, 1, 1}), 1, 1, 1);
     const auto f = sphere::estimate_porosity(snapshot_of<Real>({{Real(0.5), Real(0.5), Real(0.5), Real(0.1)}},
                                                                {{Real(1), Real(-2), Real(3)}}),
-                                             g);
+                                             g, sphere::porosity_method::cell_sphere);
     const std::size_t c = g.field_index(0, 0, 0);
     CHECK(std::abs(double(f.phi[c]) - 0.992) <= f2_tolerance<Real>());
     CHECK(f.v_p[c].x == Real(1));
@@ -293,7 +297,7 @@ TEMPLATE_TEST_CASE("F2: simple cubic lattice, cells on a void and on a particle,
         {
             const auto box = make_box<Real>({0, 0, 0}, {Real(L), Real(L), Real(L)});
             const auto g = sphere::fluid_grid<Real>::make(box, 3, 3, 3);
-            const auto f = sphere::estimate_porosity(snapshot_of(unit_lattice<Real>(0, L + 0.5, c.offset, 0.5)), g);
+            const auto f = sphere::estimate_porosity(snapshot_of(unit_lattice<Real>(0, L + 0.5, c.offset, 0.5)), g, sphere::porosity_method::cell_sphere);
             CHECK(std::abs(double(f.phi[g.field_index(1, 1, 1)]) - c.phi) <= tol);
             CHECK(std::abs(double(f.phi[g.field_index(1, 1, 1)]) - exact) <= exact_tol);
             CHECK(std::abs(double(f.d_p[g.field_index(1, 1, 1)]) - 1.0) <= 1e-6);
@@ -305,7 +309,7 @@ TEMPLATE_TEST_CASE("F2: simple cubic lattice, cells on a void and on a particle,
             const auto box = make_box<Real>({0, 0, 0}, {Real(L), Real(L), Real(L)}, true, true, true);
             const auto g = sphere::fluid_grid<Real>::make(box, 3, 3, 3);
             const auto x = unit_lattice<Real>(0, L, c.offset, 0.5);
-            const auto f = sphere::estimate_porosity(snapshot_of(x), g);
+            const auto f = sphere::estimate_porosity(snapshot_of(x), g, sphere::porosity_method::cell_sphere);
             for (int k = 0; k < 3; ++k)
                 for (int j = 0; j < 3; ++j)
                     for (int i = 0; i < 3; ++i) {
@@ -320,7 +324,7 @@ TEMPLATE_TEST_CASE("F2: simple cubic lattice, cells on a void and on a particle,
                 p.y -= Real(L);
                 p.z -= Real(2 * L);
             }
-            const auto h = sphere::estimate_porosity(snapshot_of(shifted), g);
+            const auto h = sphere::estimate_porosity(snapshot_of(shifted), g, sphere::porosity_method::cell_sphere);
             CHECK(std::abs(double(h.phi[g.field_index(0, 2, 1)]) - c.phi) <= tol);
         }
         // Periodic on x and y only, walls on z, the box at negative coordinates: x, y in [-L, 0)
@@ -333,7 +337,7 @@ TEMPLATE_TEST_CASE("F2: simple cubic lattice, cells on a void and on a particle,
             std::vector<vec4<Real>> x;
             for (const vec4<Real>& p : unit_lattice<Real>(-L, 4 * w, c.offset, 0.5))
                 if (p.x < Real(0) && p.y < Real(0) && p.z >= Real(-w)) x.push_back(p);
-            const auto f = sphere::estimate_porosity(snapshot_of(x), g);
+            const auto f = sphere::estimate_porosity(snapshot_of(x), g, sphere::porosity_method::cell_sphere);
             CHECK(std::abs(double(f.phi[g.field_index(0, 2, 2)]) - c.phi) <= tol);
             CHECK(std::abs(double(f.phi[g.field_index(2, 0, 2)]) - c.phi) <= tol);
             CHECK(std::abs(double(f.phi[g.field_index(0, 0, 2)]) - c.phi) <= tol);
@@ -359,7 +363,7 @@ TEMPLATE_TEST_CASE("porosity estimator: lens-weighted particle velocity and diam
                                        {Real(0.5), Real(0.5), Real(0), Real(0.25)},
                                        {Real(0.5), Real(-0.1), Real(0.5), Real(0.1)}};
     const std::vector<vec3<Real>> v = {{9, 0, 0}, {0, -9, 0}, {0, 0, 3}, {100, 100, 100}};
-    const auto f = sphere::estimate_porosity(snapshot_of(x, v), g);
+    const auto f = sphere::estimate_porosity(snapshot_of(x, v), g, sphere::porosity_method::cell_sphere);
 
     const double VA = 4.0 / 3.0 * pi * 0.001, VB = 8 * VA, VC = static_cast<double>(two_caps(0.5L, 0.25L, 0.5L));
     const double Vs = VA + VB + VC, Vc = pi / 6;
@@ -378,7 +382,7 @@ TEMPLATE_TEST_CASE("porosity estimator: lens-weighted particle velocity and diam
 
     // Without C the averages are hand-computable: V_B = 8 V_A, so v_p = (1, -8, 0) and
     // d_p = (0.2 + 8 * 0.4) / 9 = 0.377778 m; phi = 1 - 0.009 / 0.125 = 0.928.
-    const auto h = sphere::estimate_porosity(snapshot_of<Real>({x[0], x[1], x[3]}, {v[0], v[1], v[3]}), g);
+    const auto h = sphere::estimate_porosity(snapshot_of<Real>({x[0], x[1], x[3]}, {v[0], v[1], v[3]}), g, sphere::porosity_method::cell_sphere);
     const double ftol = sizeof(Real) == sizeof(double) ? 1e-13 : 4e-6;
     CHECK(std::abs(double(h.v_p[c0].x) - 1) <= ftol);
     CHECK(std::abs(double(h.v_p[c0].y) + 8) <= 8 * ftol);
@@ -392,7 +396,7 @@ TEMPLATE_TEST_CASE("porosity estimator: dphi/dt by backward Euler, reset, ghosts
 {
     using Real = TestType;
     const auto g = sphere::fluid_grid<Real>::make(make_box<Real>({0, 0, 0}, {1, 1, 1}), 1, 1, 1);
-    sphere::porosity_estimator<Real, sphere::host> est(g);
+    sphere::porosity_estimator<Real, sphere::host> est(g, sphere::porosity_method::cell_sphere);
     CHECK(est.cell_sphere_radius() == Real(0.5));
     const std::size_t c = g.field_index(0, 0, 0);
     const double tol = sizeof(Real) == sizeof(double) ? 1e-12 : 2e-5;
@@ -446,7 +450,7 @@ TEMPLATE_TEST_CASE("porosity estimator: non-cubic cells use R = half the smalles
     // phi = 1 - (0.1 / 0.25)^3 = 0.936, and a particle 0.3 from that centre along x (outside
     // the sphere, though inside the cell) changes nothing.
     const auto g = sphere::fluid_grid<Real>::make(make_box<Real>({0, 0, 0}, {2, 2, 1}), 2, 1, 2);
-    sphere::porosity_estimator<Real, sphere::host> est(g);
+    sphere::porosity_estimator<Real, sphere::host> est(g, sphere::porosity_method::cell_sphere);
     CHECK(est.cell_sphere_radius() == Real(0.25));
     const vec3<Real> c = g.centre(1, 0, 1);
     CHECK(c.x == Real(1.5));
@@ -458,13 +462,27 @@ TEMPLATE_TEST_CASE("porosity estimator: non-cubic cells use R = half the smalles
 }
 
 namespace {
+/// Independent reference for porosity_method::cell_volume's fractions: the share of the volume
+/// of a sphere of radius r centred at 0 that lies between the planes a < b (either may be
+/// infinite), by Simpson's rule on its cross-section pi (r^2 - z^2), which is exact for that
+/// quadratic.
+double slab_fraction(double r, double a, double b)
+{
+    a = a < -r ? -r : a;
+    b = b > r ? r : b;
+    if (!(b > a)) return 0;
+    const auto area = [r](double z) { return pi * (r * r - z * z); };
+    return (b - a) / 6 * (area(a) + 4 * area(0.5 * (a + b)) + area(b)) / (4.0 / 3.0 * pi * r * r * r);
+}
+
 /// Runs the estimator on `n_particles` random particles (radii uniform in [r_lo, r_hi], one in
 /// ten in [r_big_lo, r_big_hi]) and checks every cell's fields against a double-precision sum
-/// over every particle (nearest image on periodic axes, two-cap lens); returns the number of
-/// cells that meet some particle.
+/// over every particle (nearest image on periodic axes; two-cap lens for cell_sphere, Simpson
+/// slab fractions for cell_volume); returns the number of cells that meet some particle.
 template <class Real>
 int check_against_brute_force(const sphere::fluid_grid<Real>& g, int n_particles, double r_lo, double r_hi,
-                              double r_big_lo, double r_big_hi, unsigned seed)
+                              double r_big_lo, double r_big_hi, unsigned seed,
+                              sphere::porosity_method method = sphere::porosity_method::cell_sphere)
 {
     std::mt19937_64 gen(seed);
     std::uniform_real_distribution<double> u(0, 1);
@@ -479,10 +497,13 @@ int check_against_brute_force(const sphere::fluid_grid<Real>& g, int n_particles
         x.push_back(xp);
         v.push_back({Real(u(gen) - 0.5), Real(u(gen) - 0.5), Real(u(gen) - 0.5)});
     }
-    sphere::porosity_estimator<Real, sphere::host> est(g);
+    sphere::porosity_estimator<Real, sphere::host> est(g, method);
     est.update(snapshot_of(x, v), Real(1));
     const auto f = est.fields();
-    const double R = double(est.cell_sphere_radius()), Vc = 4.0 / 3.0 * pi * R * R * R;
+    const bool sphere_sample = method == sphere::porosity_method::cell_sphere;
+    const double R = double(est.cell_sphere_radius());
+    const double Vc = sphere_sample ? 4.0 / 3.0 * pi * R * R * R
+                                    : double(g.width.x) * double(g.width.y) * double(g.width.z);
     // Round-off of sums of up to ~100 lenses relative to V_c.
     const double tol = sizeof(Real) == sizeof(double) ? 1e-12 : 1e-5;
     int touched = 0;
@@ -500,8 +521,20 @@ int check_against_brute_force(const sphere::fluid_grid<Real>& g, int n_particles
                             const double L = double(g.box.length(a));
                             d[a] -= L * std::nearbyint(d[a] / L);
                         }
-                    const double dist = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-                    const double V = static_cast<double>(two_caps(R, double(x[p].w), dist));
+                    const double r = double(x[p].w);
+                    double V = 4.0 / 3.0 * pi * r * r * r;
+                    if (sphere_sample) {
+                        V = static_cast<double>(two_caps(R, r, std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2])));
+                    } else {
+                        const int ijk[3] = {i, j, k};
+                        for (int a = 0; a < 3; ++a) {
+                            const double h = 0.5 * double(g.width[a]), inf = std::numeric_limits<double>::infinity();
+                            const bool wall = !g.box.periodic(a);
+                            const double lo = wall && ijk[a] == 0 ? -inf : -h - d[a];
+                            const double hi = wall && ijk[a] == int(g.n[a]) - 1 ? inf : h - d[a];
+                            V *= slab_fraction(r, lo, hi);
+                        }
+                    }
                     Vs += V;
                     Vd += V * 2 * double(x[p].w);
                     Vv += vec3<double>{double(v[p].x), double(v[p].y), double(v[p].z)} * V;
@@ -550,6 +583,138 @@ TEMPLATE_TEST_CASE("porosity estimator: the binned search matches a brute-force 
         const auto box = make_box<Real>({0, 0, 0}, {1, 1, 1});
         CHECK(check_against_brute_force(sphere::fluid_grid<Real>::make(box, 2, 2, 2), 0, 0.1, 0.1, 0.1, 0.1, 1) == 0);
     }
+    SECTION("cell_volume: periodic x and z, walls on y; some particles wider than a cell")
+    {
+        // Half-widths 0.2, 0.25, 0.15 m; radii up to 0.45 m <= L_z / 2 - 0.15 = 0.75 m.
+        const auto box =
+            make_box<Real>({Real(-1), Real(0), Real(2)}, {Real(1.4), Real(2), Real(3.8)}, true, false, true);
+        CHECK(check_against_brute_force(sphere::fluid_grid<Real>::make(box, 6, 4, 6), 300, 0.02, 0.12, 0.3, 0.45, 17,
+                                        sphere::porosity_method::cell_volume) > 100);
+    }
+    SECTION("cell_volume: short periodic axes, walls on z")
+    {
+        // Half-widths 0.25 and 0.2 m on the periodic axes, radii up to 0.25 m.
+        const auto box = make_box<Real>({0, 0, 0}, {Real(1), Real(1.2), Real(1.6)}, true, true, false);
+        CHECK(check_against_brute_force(sphere::fluid_grid<Real>::make(box, 2, 3, 4), 60, 0.02, 0.1, 0.2, 0.25, 5,
+                                        sphere::porosity_method::cell_volume) > 20);
+    }
+}
+
+namespace {
+/// Random particles over `box` (centres up to `overhang` metres beyond its wall faces), with
+/// radii in [r_lo, r_hi].
+template <class Real>
+std::vector<vec4<Real>> random_particles(const sphere::world<Real>& box, int n, double r_lo, double r_hi,
+                                         double overhang, unsigned seed)
+{
+    std::mt19937_64 gen(seed);
+    std::uniform_real_distribution<double> u(0, 1);
+    std::vector<vec4<Real>> x;
+    for (int p = 0; p < n; ++p) {
+        double c[3];
+        for (int a = 0; a < 3; ++a) {
+            const double extra = box.periodic(a) ? 0 : overhang;
+            c[a] = double(box.lo[a]) - extra + (double(box.length(a)) + 2 * extra) * u(gen);
+            if (box.periodic(a) && c[a] >= double(box.hi[a])) c[a] = double(box.lo[a]);
+        }
+        x.push_back({Real(c[0]), Real(c[1]), Real(c[2]), Real(r_lo + (r_hi - r_lo) * u(gen))});
+    }
+    return x;
+}
+
+template <class Real>
+double total_volume(const std::vector<vec4<Real>>& x)
+{
+    double v = 0;
+    for (const vec4<Real>& p : x) v += 4.0 / 3.0 * pi * double(p.w) * double(p.w) * double(p.w);
+    return v;
+}
+
+/// Solid volume of the cells of layers [k_lo, k_hi] along z: sum of (1 - phi) V_cell (m^3).
+template <class Real>
+double solid_in_layers(const sphere::porosity_fields<Real>& f, int k_lo, int k_hi)
+{
+    const auto& g = f.grid;
+    const double Vc = double(g.width.x) * double(g.width.y) * double(g.width.z);
+    double s = 0;
+    for (int k = k_lo; k <= k_hi; ++k)
+        for (int j = 0; j < int(g.n[1]); ++j)
+            for (int i = 0; i < int(g.n[0]); ++i) s += (1 - double(f.phi[g.field_index(i, j, k)])) * Vc;
+    return s;
+}
+} // namespace
+
+TEMPLATE_TEST_CASE("cell_volume porosity conserves the solid volume: the grid's and every layer's", "[fluid][porosity]",
+                   float, double)
+{
+    using Real = TestType;
+    // 400 particles crossing cell faces, periodic boundaries on x and y, and poking through the
+    // walls at the bottom and top (centres up to 0.05 m beyond them): the cells hold the
+    // particles' total volume, and each layer of cells exactly the volume between its planes
+    // (the outermost layers what lies beyond the walls too), against slab_fraction.
+    const auto box = make_box<Real>({Real(-0.5), Real(0), Real(0)}, {Real(0.7), Real(1), Real(1.5)}, true, true, false);
+    const auto g = sphere::fluid_grid<Real>::make(box, 4, 5, 6);
+    const auto x = random_particles(box, 400, 0.01, 0.09, 0.05, 3);
+    const auto f = sphere::estimate_porosity(snapshot_of(x), g);
+    const double total = total_volume(x);
+    const double tol = sizeof(Real) == sizeof(double) ? 1e-12 : 2e-5;
+    INFO("particle volume " << total << " m^3");
+    CHECK(std::abs(solid_in_layers(f, 0, 5) - total) <= tol * total);
+    const double w = double(g.width.z), inf = std::numeric_limits<double>::infinity();
+    for (int k = 0; k < 6; ++k) {
+        const double lo = k == 0 ? -inf : k * w, hi = k == 5 ? inf : (k + 1) * w;
+        double expected = 0;
+        for (const vec4<Real>& p : x) {
+            const double r = double(p.w), V = 4.0 / 3.0 * pi * r * r * r;
+            expected += V * slab_fraction(r, lo - double(p.z), hi - double(p.z));
+        }
+        INFO("layer " << k);
+        CHECK(std::abs(solid_in_layers(f, k, k) - expected) <= tol * total);
+    }
+    // A simple cubic lattice of spacing 1, r = 0.5, in cells of two periods: every cell holds 8
+    // particles' worth of volume, phi = 1 - pi/6 wherever the lattice sits.
+    for (double offset : {0.0, 0.3, 0.5}) {
+        const auto lattice_box = make_box<Real>({0, 0, 0}, {6, 6, 6}, true, true, true);
+        const auto lg = sphere::fluid_grid<Real>::make(lattice_box, 3, 3, 3);
+        const auto lf = sphere::estimate_porosity(snapshot_of(unit_lattice<Real>(0, 6, offset, 0.5)), lg);
+        for (int k = 0; k < 3; ++k)
+            for (int j = 0; j < 3; ++j)
+                for (int i = 0; i < 3; ++i) {
+                    INFO("offset " << offset << ", cell " << i << " " << j << " " << k);
+                    CHECK(std::abs(double(lf.phi[lg.field_index(i, j, k)]) - (1 - pi / 6)) <= 10 * tol);
+                }
+    }
+}
+
+TEMPLATE_TEST_CASE("cell_volume porosity: a moving particle's rate sums to zero over the grid", "[fluid][porosity]",
+                   float, double)
+{
+    using Real = TestType;
+    // Particles move across faces and through a periodic boundary between two updates: the
+    // rates change the porosity of single cells by up to ~1e-2/s, but sum (dphi/dt) V_cell over
+    // the grid to round-off, the closed box's compatibility condition.
+    const auto box = make_box<Real>({0, 0, 0}, {Real(1), Real(1), Real(2)}, true, true, false);
+    const auto g = sphere::fluid_grid<Real>::make(box, 4, 4, 8);
+    sphere::porosity_estimator<Real, sphere::host> est(g);
+    auto x = random_particles(box, 200, 0.02, 0.1, 0, 11);
+    est.update(snapshot_of(x), Real(0.1));
+    for (vec4<Real>& p : x) {
+        p.x = box.wrap(p.x + Real(0.13), 0);
+        p.z = p.z - Real(0.07);
+    }
+    est.update(snapshot_of(x), Real(0.1));
+    const auto f = est.fields();
+    double sum = 0, largest = 0;
+    for (int k = 0; k < 8; ++k)
+        for (int j = 0; j < 4; ++j)
+            for (int i = 0; i < 4; ++i) {
+                const double rate = double(f.dphi_dt[g.field_index(i, j, k)]);
+                sum += rate;
+                largest = std::max(largest, std::abs(rate));
+            }
+    INFO("largest cell rate " << largest << " 1/s, sum " << sum);
+    CHECK(largest > 1e-2);
+    CHECK(std::abs(sum) <= (sizeof(Real) == sizeof(double) ? 1e-12 : 1e-4) * largest * 128);
 }
 
 TEMPLATE_TEST_CASE("fluid grid and porosity estimator: errors name the bad value", "[fluid][porosity]", float, double)
@@ -581,10 +746,15 @@ TEMPLATE_TEST_CASE("fluid grid and porosity estimator: errors name the bad value
     // One cell along a periodic x: R = 0.5 of a 1 m period, so any particle could meet the cell
     // sphere through two images; 2 cells (R = 0.25) with r = 0.1 are fine, r = 0.3 is not.
     const auto periodic = make_box<Real>({0, 0, 0}, {1, 1, 1}, true, false, false);
-    sphere::porosity_estimator<Real, sphere::host> one(grid::make(periodic, 1, 1, 1));
+    sphere::porosity_estimator<Real, sphere::host> one(grid::make(periodic, 1, 1, 1), sphere::porosity_method::cell_sphere);
     CHECK_THROWS_WITH(one.update(s, Real(1)), Catch::Contains("periodic axis x of length 1 m is shorter than twice"));
-    sphere::porosity_estimator<Real, sphere::host> two(grid::make(periodic, 2, 2, 2));
+    sphere::porosity_estimator<Real, sphere::host> two(grid::make(periodic, 2, 2, 2), sphere::porosity_method::cell_sphere);
     CHECK_NOTHROW(two.update(s, Real(1)));
     const auto big = snapshot_of<Real>({{Real(0.5), Real(0.5), Real(0.5), Real(0.3)}});
     CHECK_THROWS_WITH(two.update(big, Real(1)), Catch::Contains("use more fluid cells along x"));
+    // cell_volume reaches half a cell width: 2 cells (0.25 m) with r = 0.3 > 0.5 - 0.25.
+    sphere::porosity_estimator<Real, sphere::host> volume(grid::make(periodic, 2, 2, 2));
+    CHECK(volume.method() == sphere::porosity_method::cell_volume);
+    CHECK_THROWS_WITH(volume.update(big, Real(1)),
+                      Catch::Contains("periodic axis x of length 1 m is shorter than twice half the cell width 0.25 m"));
 }

@@ -71,6 +71,8 @@ int run(const options& o)
     coupling_options opt;
     opt.dem_steps = o.dem_steps;
     opt.pressure_force = !o.no_pressure_force;
+    // VALIDATION F6's reference porosity (0.992) is the seeds' cell-sphere estimate.
+    opt.porosity = porosity_method::cell_sphere;
     Coupling coupled(fluid_grid<Real>::make(s.box, o.nx, o.nx, o.nz), prm, opt);
     const fluid_grid<Real>& grid = coupled.fluid().grid();
 

@@ -4,11 +4,11 @@
 ///
 /// One coupled step of length dt_f = dem_steps x (DEM time step):
 ///   1. the porosity estimator bins the particles by fluid cell and computes each cell's
-///      porosity, its rate, and the lens-weighted mean particle velocity and diameter;
+///      porosity, its rate, and the volume-weighted mean particle velocity and diameter;
 ///   2. every particle gets the fluid force of its cell (the cell holding its centre)
 ///        f_i = Drag::beta_per_solid(phi, d, |v_f - v_p|) (v_f - v_p) V_i  [ - V_i grad p ]
 ///      with the cell's porosity phi, fluid velocity v_f, mean particle velocity v_p and mean
-///      diameter d (the particle's own velocity and diameter where the cell sphere holds no
+///      diameter d (the particle's own velocity and diameter where the cell holds no
 ///      solid); the bracket is the optional pressure-gradient (buoyancy) force;
 ///   3. the fluid gets the opposite of the sum of its particles' forces, per unit cell volume,
 ///      so that momentum is exchanged exactly (summed per cell in particle order:
@@ -44,6 +44,9 @@ namespace sphere {
 struct coupling_options {
     unsigned dem_steps = 10;     ///< DEM steps per fluid step
     bool pressure_force = true;  ///< apply -V_p grad p to the particles (and its reaction to the fluid)
+    /// How the cells' solid volume is measured: cell_volume conserves the grid's solid volume
+    /// (needed for a closed box); cell_sphere is the seeds' estimator.
+    porosity_method porosity = porosity_method::cell_volume;
 };
 
 namespace detail {
@@ -149,7 +152,7 @@ template <class Real, class Policy, class Drag = drag::gidaspow, class Poisson =
 class fluid_coupling {
 public:
     fluid_coupling(const fluid_grid<Real>& g, const fluid_params<Real>& params, const coupling_options& options = {})
-        : options_(options), porosity_(g), fluid_(g, params)
+        : options_(options), porosity_(g, options.porosity), fluid_(g, params)
     {
         if (options.dem_steps < 1) detail::fail("coupling: dem_steps = 0; at least one DEM step per fluid step");
         Drag::validate();

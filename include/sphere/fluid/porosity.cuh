@@ -1,8 +1,9 @@
 #pragma once
 /// \file
-/// The porosity estimator (docs/fluid.md, *Porosity*): for every fluid cell, the volume its
-/// cell-centred sphere shares with the particles gives the porosity, the lens-weighted mean
-/// particle velocity and diameter, and by backward Euler the porosity's rate of change.
+/// The porosity estimator (docs/fluid.md, *Porosity*): for every fluid cell, the solid volume
+/// the particles put in it (the share of each particle's volume that falls in the cell, or the
+/// seeds' volume shared with a cell-centred sphere) gives the porosity, the volume-weighted
+/// mean particle velocity and diameter, and by backward Euler the porosity's rate of change.
 #include <cmath>
 #include <cstddef>
 #include <vector>
@@ -20,16 +21,31 @@
 
 namespace sphere {
 
+/// How the porosity estimator measures a cell's solid volume (docs/fluid.md, *Porosity*).
+enum class porosity_method {
+    /// Each particle's volume is shared among the cells its sphere reaches, cell (i, j, k)
+    /// taking V f_x(i) f_y(j) f_z(k), where f_a(i) is the fraction of the sphere's volume
+    /// between the cell's two faces normal to axis a (the outermost cells of a wall axis reach
+    /// to infinity). The shares of a particle sum to its volume, so the solid volume of the
+    /// grid is conserved exactly (a closed box's compatibility condition), and the solid volume
+    /// of every layer of cells is exactly that of the particles between its planes. The default.
+    cell_volume,
+    /// The volume each particle shares with the cell's inscribed sphere (radius half the
+    /// smallest cell width), over that sphere's volume: the seeds' estimator (F1, F2). It sees
+    /// 52% of a cubic cell, so the grid's solid volume is not conserved.
+    cell_sphere
+};
+
 /// Kernel view of the estimator's fields, each in the fluid grid's field layout
 /// (`fluid_grid::field_index`, ghost nodes included; the estimator writes the cells only).
 template <class Real>
 struct porosity_view {
     fluid_grid<Real> grid;
-    Real radius;           ///< radius R of the cell spheres (m)
+    Real radius;           ///< radius R of the cell spheres (m; porosity_method::cell_sphere)
     const Real* phi;       ///< porosity (-)
     const Real* dphi_dt;   ///< its rate of change (1/s)
-    const vec3<Real>* v_p; ///< lens-weighted mean particle velocity (m/s); 0 where no particle
-    const Real* d_p;       ///< lens-weighted mean particle diameter (m); 0 where no particle
+    const vec3<Real>* v_p; ///< volume-weighted mean particle velocity (m/s); 0 where no particle
+    const Real* d_p;       ///< volume-weighted mean particle diameter (m); 0 where no particle
 };
 
 /// Host copies of the estimator's fields, in the fluid grid's field layout: the value of cell
@@ -49,12 +65,23 @@ struct particle_radius {
     SPHERE_HD Real operator()(std::size_t i) const { return x[i].w; }
 };
 
-/// Fluid cell c gathers every particle whose sphere meets its cell sphere (centre at the cell
-/// centre, radius R; nearest periodic image) from the bins (the fluid cells themselves, see
-/// porosity_estimator) within [lo_offset, hi_offset] of its own along each axis, and writes
-/// its own entries of the fields:
-///   V_s = sum_j lens_volume(R, r_j, d_j)
-///   phi = 1 - V_s / (4/3 pi R^3)
+/// The fraction of a sphere's volume below the plane at t radii from its centre (t in any
+/// range): 0 for t <= -1, 1 for t >= 1, the cap (1 + t)^2 (2 - t) / 4 between (docs/fluid.md,
+/// *Porosity*).
+template <class Real>
+SPHERE_HD Real volume_fraction_below(Real t)
+{
+    if (!(t > Real(-1))) return Real(0);
+    if (!(t < Real(1))) return Real(1);
+    return (Real(1) + t) * (Real(1) + t) * (Real(2) - t) / Real(4);
+}
+
+/// Fluid cell c gathers every particle that can reach it (nearest periodic image) from the bins
+/// (the fluid cells themselves, see porosity_estimator) within [lo_offset, hi_offset] of its
+/// own along each axis, and writes its own entries of the fields:
+///   V_j = the particle's solid volume in the cell (porosity_method; m^3)
+///   V_s = sum_j V_j
+///   phi = 1 - V_s / V_c   (V_c the cell's volume, or its sphere's for cell_sphere)
 ///   v_p = sum_j V_j v_j / V_s,  d_p = sum_j V_j 2 r_j / V_s   (0 when V_s = 0)
 ///   dphi/dt = (phi - phi_previous) / dt   (0 without a previous porosity)
 /// phi is read (as the previous value) and written at the same index, by this cell only.
@@ -63,7 +90,8 @@ struct estimate_cell_porosity {
     fluid_grid<Real> fluid;
     grid_view<Real> bins;
     const vec3<Real>* v; ///< particle velocities at the positions' time, user order (m/s)
-    Real radius;
+    porosity_method method;
+    Real radius;         ///< the cell spheres' radius R (m; cell_sphere)
     int lo_offset[3];
     int hi_offset[3];
     bool have_previous;
@@ -77,7 +105,13 @@ struct estimate_cell_porosity {
     {
         int ijk[3];
         fluid.coordinates(c, ijk[0], ijk[1], ijk[2]);
-        const vec3<Real> centre = fluid.centre(ijk[0], ijk[1], ijk[2]);
+        cell_place cell;
+        cell.centre = fluid.centre(ijk[0], ijk[1], ijk[2]);
+        for (int a = 0; a < 3; ++a) {
+            const bool wall = !fluid.box.periodic(a);
+            cell.open_lo[a] = wall && ijk[a] == 0;
+            cell.open_hi[a] = wall && ijk[a] == static_cast<int>(fluid.n[a]) - 1;
+        }
         int first[3], count[3];
         for (int a = 0; a < 3; ++a) bin_range(ijk[a], a, first[a], count[a]);
         const int nx = static_cast<int>(fluid.n[0]);
@@ -91,15 +125,17 @@ struct estimate_cell_porosity {
                 const int bi = wrap(first[0], 0);
                 const int end = bi + count[0] - 1;
                 if (end < nx) {
-                    gather(fluid.index(bi, bj, bk), fluid.index(end, bj, bk), centre, s);
+                    gather(fluid.index(bi, bj, bk), fluid.index(end, bj, bk), cell, s);
                 } else {
-                    gather(fluid.index(bi, bj, bk), fluid.index(nx - 1, bj, bk), centre, s);
-                    gather(fluid.index(0, bj, bk), fluid.index(end - nx, bj, bk), centre, s);
+                    gather(fluid.index(bi, bj, bk), fluid.index(nx - 1, bj, bk), cell, s);
+                    gather(fluid.index(0, bj, bk), fluid.index(end - nx, bj, bk), cell, s);
                 }
             }
         }
         const std::size_t f = fluid.field_index(ijk[0], ijk[1], ijk[2]);
-        const Real porosity = Real(1) - s.solid / sphere_volume(radius);
+        const Real sampled = method == porosity_method::cell_sphere ? sphere_volume(radius)
+                                                                    : fluid.width.x * fluid.width.y * fluid.width.z;
+        const Real porosity = Real(1) - s.solid / sampled;
         dphi_dt[f] = have_previous ? (porosity - phi[f]) / dt : Real(0);
         phi[f] = porosity;
         const bool any = s.solid > Real(0);
@@ -108,6 +144,13 @@ struct estimate_cell_porosity {
     }
 
 private:
+    /// The cell's centre, and which of its faces are the open outer side of an outermost cell
+    /// on a wall axis (cell_volume: that side reaches to infinity).
+    struct cell_place {
+        vec3<Real> centre;
+        bool open_lo[3], open_hi[3];
+    };
+
     struct sums {
         Real solid;        ///< sum of V_j (m^3)
         Real diameter;     ///< sum of V_j 2 r_j (m^4)
@@ -139,21 +182,36 @@ private:
         return fluid.box.periodic(a) ? ((b % n) + n) % n : b;
     }
 
-    /// Adds every particle of bins [first_bin, last_bin] (consecutive along x) that meets the
-    /// cell sphere.
-    SPHERE_HD void gather(std::size_t first_bin, std::size_t last_bin, const vec3<Real>& centre, sums& s) const
+    /// Adds every particle of bins [first_bin, last_bin] (consecutive along x) that reaches
+    /// the cell.
+    SPHERE_HD void gather(std::size_t first_bin, std::size_t last_bin, const cell_place& cell, sums& s) const
     {
         const unsigned end = bins.cell_start[last_bin + 1];
         for (unsigned k = bins.cell_start[first_bin]; k < end; ++k) {
             const vec4<Real> xj = bins.sorted_x[k];
-            const Real reach = radius + xj.w;
-            const Real d2 = norm2(fluid.box.nearest_image(xj.xyz() - centre));
-            if (!(d2 < reach * reach)) continue;
-            const Real V = lens_volume(radius, xj.w, std::sqrt(d2));
+            const vec3<Real> d = fluid.box.nearest_image(xj.xyz() - cell.centre);
+            const Real V = method == porosity_method::cell_sphere ? lens_volume(radius, xj.w, std::sqrt(norm2(d)))
+                                                                  : volume_in_cell(d, xj.w, cell);
+            if (!(V > Real(0))) continue;
             s.solid += V;
             s.diameter += V * (Real(2) * xj.w);
             s.velocity += V * v[bins.order[k]];
         }
+    }
+
+    /// porosity_method::cell_volume: the volume (m^3) of a sphere of radius r whose centre lies
+    /// at d from the cell's centre, times the fractions of it between the cell's faces along
+    /// each axis; the outermost cells of a wall axis reach to infinity on their outer side.
+    SPHERE_HD Real volume_in_cell(const vec3<Real>& d, Real r, const cell_place& cell) const
+    {
+        Real share = sphere_volume(r);
+        for (int a = 0; a < 3; ++a) {
+            const Real half = Real(0.5) * fluid.width[a];
+            const Real below_hi = cell.open_hi[a] ? Real(1) : volume_fraction_below((half - d[a]) / r);
+            const Real below_lo = cell.open_lo[a] ? Real(0) : volume_fraction_below((-half - d[a]) / r);
+            share *= below_hi - below_lo;
+        }
+        return share;
     }
 };
 } // namespace detail
@@ -164,30 +222,35 @@ private:
 /// phi = 1 and 0 and are the boundary conditions' to fill) and recomputes them from the
 /// particles with `update`, once per fluid step.
 ///
-/// Cell sphere: centred on the cell, radius R = min(width) / 2, so that it lies inside its
-/// cell whatever the cells' aspect (for cubic cells, half the cell width as in the seeds).
+/// The solid volume of a cell (porosity_method): by default each particle's volume shared
+/// among the cells its sphere reaches (the grid's solid volume conserved); with cell_sphere,
+/// what it shares with the sphere centred on the cell of radius R = min(width) / 2, which lies
+/// inside its cell whatever the cells' aspect (for cubic cells, half the cell width as in the
+/// seeds).
 ///
 /// Particle search: the particles are binned into the fluid cells themselves (a
 /// `neighbor_grid` over the fluid grid's geometry: hash, stable sort, cell starts), rebuilt
-/// from the current positions at every update, and each cell scans the bins within
-/// R + r_max of its centre (r_max the largest radius). The simulation's contact grid is not
-/// reused: it is rebuilt only when a particle has moved skin/2, so its bins can be stale, and
-/// its cells follow the particle size rather than the fluid resolution; one extra sort per
-/// fluid step (usually several DEM steps) is cheap next to the gather.
+/// from the current positions at every update, and each cell scans the bins within h_a + r_max
+/// of its centre along each axis a (h_a = width_a / 2, or R for cell_sphere; r_max the largest
+/// radius). The simulation's contact grid is not reused: it is rebuilt only when a particle
+/// has moved skin/2, so its bins can be stale, and its cells follow the particle size rather
+/// than the fluid resolution; one extra sort per fluid step (usually several DEM steps) is
+/// cheap next to the gather.
 ///
 /// Preconditions: coordinates on periodic axes lie in [lo, hi) (the simulation keeps them
-/// there; the snapshot overload wraps them), and on every periodic axis R + r_max <= L / 2, so
-/// that no particle meets a cell sphere through two periodic images (checked; an error names
+/// there; the snapshot overload wraps them), and on every periodic axis h_a + r_max <= L / 2,
+/// so that no particle reaches a cell through two periodic images (checked; an error names
 /// the axis).
 template <class Real, class Policy>
 class porosity_estimator {
 public:
-    explicit porosity_estimator(const fluid_grid<Real>& g = {})
-        : grid_(g), bins_(bin_geometry(g)), phi_(g.field_size(), Real(1)), dphi_dt_(g.field_size(), Real(0)),
-          v_p_(g.field_size(), vec3<Real>{0, 0, 0}), d_p_(g.field_size(), Real(0))
+    explicit porosity_estimator(const fluid_grid<Real>& g = {}, porosity_method method = porosity_method::cell_volume)
+        : grid_(g), method_(method), bins_(bin_geometry(g)), phi_(g.field_size(), Real(1)),
+          dphi_dt_(g.field_size(), Real(0)), v_p_(g.field_size(), vec3<Real>{0, 0, 0}), d_p_(g.field_size(), Real(0))
     {
     }
 
+    porosity_method method() const { return method_; }
     const fluid_grid<Real>& grid() const { return grid_; }
 
     /// The particles binned by fluid cell at the last update (bin index = fluid_grid::index of
@@ -201,7 +264,7 @@ public:
     /// velocities at the positions' time (p.v_sync). dt (s) is the time since the previous
     /// update, for dphi/dt = (phi - phi_previous) / dt; the first update after construction or
     /// `reset()` sets dphi/dt = 0. Throws when dt is not positive and finite, or when a
-    /// periodic axis is too short for the cell spheres (see the class comment).
+    /// periodic axis is too short for the cells' reach (see the class comment).
     void update(const particle_view<Real>& p, Real dt)
     {
         update(p, dt,
@@ -216,24 +279,28 @@ public:
         if (!(dt > Real(0)) || !std::isfinite(dt))
             detail::fail("porosity_estimator::update: dt = ", dt, " s must be positive and finite");
         const Real R = cell_sphere_radius();
+        const bool sphere = method_ == porosity_method::cell_sphere;
         const char* axis_name[3] = {"x", "y", "z"};
-        for (int a = 0; a < 3; ++a)
-            if (grid_.box.periodic(a) && R + r_max > grid_.box.length(a) / Real(2))
+        for (int a = 0; a < 3; ++a) {
+            const Real h = sphere ? R : grid_.width[a] / Real(2);
+            if (grid_.box.periodic(a) && h + r_max > grid_.box.length(a) / Real(2))
                 detail::fail("porosity_estimator: periodic axis ", axis_name[a], " of length ", grid_.box.length(a),
-                             " m is shorter than twice the cell sphere radius ", R,
+                             " m is shorter than twice ", sphere ? "the cell sphere radius " : "half the cell width ", h,
                              " m plus the largest particle radius ", r_max,
-                             " m, so a particle could meet a cell sphere through two periodic images; use more fluid "
+                             " m, so a particle could reach a cell through two periodic images; use more fluid "
                              "cells along ", axis_name[a]);
+        }
         const stream_scope<Policy> on_stream(context_);
         bins_.build(context_, p);
-        detail::estimate_cell_porosity<Real> kernel{grid_, bins_.view(), p.v_sync, R, {0, 0, 0}, {0, 0, 0},
+        detail::estimate_cell_porosity<Real> kernel{grid_, bins_.view(), p.v_sync, method_, R, {0, 0, 0}, {0, 0, 0},
                                                     have_previous_, dt, phi_.data(), dphi_dt_.data(), v_p_.data(),
                                                     d_p_.data()};
-        // Bins along a (of width w) that can hold a centre within R + r_max of the centre of
-        // cell i, at (i + 1/2) w: i + floor(1/2 -+ s) with s = (R + r_max) / w, widened by
+        // Bins along a (of width w) that can hold a centre within h + r_max of the centre of
+        // cell i, at (i + 1/2) w: i + floor(1/2 -+ s) with s = (h + r_max) / w, widened by
         // 1e-4 of a bin against round-off in the hash, and bounded by the grid's size.
         for (int a = 0; a < 3; ++a) {
-            const double s = double(R + r_max) / double(grid_.width[a]) + 1e-4;
+            const Real h = sphere ? R : grid_.width[a] / Real(2);
+            const double s = double(h + r_max) / double(grid_.width[a]) + 1e-4;
             const double n = double(grid_.n[a]);
             const double lo = std::floor(0.5 - s), hi = std::floor(0.5 + s);
             kernel.lo_offset[a] = static_cast<int>(lo < -n ? -n : lo);
@@ -291,6 +358,7 @@ private:
     }
 
     fluid_grid<Real> grid_;
+    porosity_method method_;
     execution_context<Policy> context_; ///< the bins' sort and scans
     neighbor_grid<Real, Policy> bins_;
     buffer<Real, Policy> phi_, dphi_dt_;
@@ -304,9 +372,10 @@ private:
 /// The porosity, mean particle velocity and mean diameter of every cell of `g` for the
 /// particles of a host snapshot (x and v_sync), on the host backend; dphi_dt is 0.
 template <class Real>
-porosity_fields<Real> estimate_porosity(const particle_snapshot<Real>& s, const fluid_grid<Real>& g)
+porosity_fields<Real> estimate_porosity(const particle_snapshot<Real>& s, const fluid_grid<Real>& g,
+                                        porosity_method method = porosity_method::cell_volume)
 {
-    porosity_estimator<Real, host> estimator(g);
+    porosity_estimator<Real, host> estimator(g, method);
     estimator.update(s, Real(1));
     return estimator.fields();
 }
