@@ -1,6 +1,6 @@
 // Google Benchmark micro-benchmarks of the pore fluid on the host backend: one pressure solve
-// by Jacobi and by conjugate gradients on n^3 grids (counter: iterations), one fluid step, and
-// one coupled step with particles, in float and double.
+// by Jacobi, by conjugate gradients and by multigrid-preconditioned CG on n^3 grids (counter:
+// iterations), one fluid step, and one coupled step with particles, in float and double.
 // Run: build/bench/bench_fluid --benchmark_counters_tabular=true   (docs/performance.md)
 #include <sphere/dem.cuh>
 #include <sphere/fluid.cuh>
@@ -23,7 +23,7 @@ sphere::fluid_grid<Real> cube_grid(int n)
 }
 
 /// One solve of a Poisson problem with a pseudo-random right-hand side, Dirichlet top and
-/// Neumann bottom, from a zero guess, to relative residual 1e-6 (double) or 1e-4 (float, whose
+/// Neumann bottom, from a zero guess, to relative residual 1e-8 (double) or 1e-4 (float, whose
 /// round-off floor is near 1e-5).
 template <class Real, class Solver>
 void poisson_solve(benchmark::State& state)
@@ -38,7 +38,7 @@ void poisson_solve(benchmark::State& state)
             for (int i = 0; i < n; ++i) rhs[g.field_index(i, j, k)] = Real(unit(rng));
     Solver solver(g);
     sphere::poisson_settings s;
-    s.tolerance = sizeof(Real) == 8 ? 1e-6 : 1e-4;
+    s.tolerance = sizeof(Real) == 8 ? 1e-8 : 1e-4;
     s.max_iterations = 1000000;
     const sphere::poisson_boundaries bc{sphere::z_boundary::neumann, sphere::z_boundary::dirichlet};
     unsigned iterations = 0;
@@ -51,8 +51,9 @@ void poisson_solve(benchmark::State& state)
     state.counters["cells"] = double(g.cell_count());
 }
 
-/// One step of a fluid on its own (a shear wave under gravity in a closed box, CG).
-template <class Real>
+/// One step of a fluid on its own (a shear wave under gravity, Dirichlet top), with the
+/// Poisson solver `Solver`.
+template <class Real, class Solver>
 void fluid_step(benchmark::State& state)
 {
     const int n = static_cast<int>(state.range(0));
@@ -60,7 +61,7 @@ void fluid_step(benchmark::State& state)
     prm.gravity = {0, 0, Real(-9.81)};
     prm.top = sphere::fluid_boundary<Real>::prescribed_pressure(0);
     prm.poisson.tolerance = sizeof(Real) == 8 ? 1e-8 : 1e-4;
-    sphere::navier_stokes<Real, sphere::host, sphere::cg_poisson<Real, sphere::host>> fluid(cube_grid<Real>(n), prm);
+    sphere::navier_stokes<Real, sphere::host, Solver> fluid(cube_grid<Real>(n), prm);
     fluid.set_velocity([](const sphere::vec3<Real>& x) {
         return sphere::vec3<Real>{0, Real(0.01) * std::sin(Real(20) * x.x), 0};
     });
@@ -68,8 +69,9 @@ void fluid_step(benchmark::State& state)
     state.counters["cells/s"] = benchmark::Counter(double(fluid.grid().cell_count()), benchmark::Counter::kIsIterationInvariantRate);
 }
 
-/// One coupled step (10 DEM steps) of 8000 particles settling through 16^3 fluid cells.
-template <class Real>
+/// One coupled step (10 DEM steps) of 8000 particles settling through 16 x 16 x 32 fluid cells
+/// in a closed box, with the Poisson solver `Solver`.
+template <class Real, class Solver>
 void coupled_step(benchmark::State& state)
 {
     sphere::settings<Real> s;
@@ -97,7 +99,7 @@ void coupled_step(benchmark::State& state)
     prm.poisson.tolerance = sizeof(Real) == 8 ? 1e-8 : 1e-4;
     sphere::coupling_options opt;
     opt.dem_steps = 10;
-    sphere::fluid_coupling<Real, sphere::host, sphere::drag::gidaspow, sphere::cg_poisson<Real, sphere::host>> coupled(
+    sphere::fluid_coupling<Real, sphere::host, sphere::drag::gidaspow, Solver> coupled(
         sphere::fluid_grid<Real>::make(s.box, 16, 16, 32), prm, opt);
     for (auto _ : state) coupled.step(sim);
     state.counters["particle-steps/s"] =
@@ -107,11 +109,15 @@ void coupled_step(benchmark::State& state)
 } // namespace
 
 BENCHMARK_TEMPLATE(poisson_solve, double, sphere::jacobi_poisson<double, sphere::host>)->Arg(16)->Arg(32)->Unit(benchmark::kMillisecond);
-BENCHMARK_TEMPLATE(poisson_solve, double, sphere::cg_poisson<double, sphere::host>)->Arg(16)->Arg(32)->Arg(64)->Unit(benchmark::kMillisecond);
+BENCHMARK_TEMPLATE(poisson_solve, double, sphere::cg_poisson<double, sphere::host>)->Arg(16)->Arg(32)->Arg(64)->Arg(128)->Unit(benchmark::kMillisecond);
+BENCHMARK_TEMPLATE(poisson_solve, double, sphere::mg_poisson<double, sphere::host>)->Arg(16)->Arg(32)->Arg(64)->Arg(128)->Unit(benchmark::kMillisecond);
 BENCHMARK_TEMPLATE(poisson_solve, float, sphere::cg_poisson<float, sphere::host>)->Arg(32)->Arg(64)->Unit(benchmark::kMillisecond);
-BENCHMARK_TEMPLATE(fluid_step, float)->Arg(32)->Unit(benchmark::kMillisecond);
-BENCHMARK_TEMPLATE(fluid_step, double)->Arg(32)->Unit(benchmark::kMillisecond);
-BENCHMARK_TEMPLATE(coupled_step, float)->Unit(benchmark::kMillisecond);
-BENCHMARK_TEMPLATE(coupled_step, double)->Unit(benchmark::kMillisecond);
+BENCHMARK_TEMPLATE(poisson_solve, float, sphere::mg_poisson<float, sphere::host>)->Arg(32)->Arg(64)->Unit(benchmark::kMillisecond);
+BENCHMARK_TEMPLATE(fluid_step, float, sphere::cg_poisson<float, sphere::host>)->Arg(32)->Unit(benchmark::kMillisecond);
+BENCHMARK_TEMPLATE(fluid_step, double, sphere::cg_poisson<double, sphere::host>)->Arg(32)->Arg(64)->Unit(benchmark::kMillisecond);
+BENCHMARK_TEMPLATE(fluid_step, double, sphere::mg_poisson<double, sphere::host>)->Arg(32)->Arg(64)->Unit(benchmark::kMillisecond);
+BENCHMARK_TEMPLATE(coupled_step, float, sphere::cg_poisson<float, sphere::host>)->Unit(benchmark::kMillisecond);
+BENCHMARK_TEMPLATE(coupled_step, double, sphere::cg_poisson<double, sphere::host>)->Unit(benchmark::kMillisecond);
+BENCHMARK_TEMPLATE(coupled_step, double, sphere::mg_poisson<double, sphere::host>)->Unit(benchmark::kMillisecond);
 
 BENCHMARK_MAIN();

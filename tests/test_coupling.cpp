@@ -33,7 +33,7 @@ constexpr double pi = 3.14159265358979323846;
 template <class Real>
 using sim_t = sphere::simulation<Real, sphere::host>;
 template <class Real, class Drag = sphere::drag::gidaspow>
-using coupling_t = sphere::fluid_coupling<Real, sphere::host, Drag, sphere::cg_poisson<Real, sphere::host>>;
+using coupling_t = sphere::fluid_coupling<Real, sphere::host, Drag>;  // the default pressure solver (mg_poisson)
 
 template <class Real>
 sphere::settings<Real> periodic_column(double lx, double ly, double lz, double k_n)

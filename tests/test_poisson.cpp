@@ -14,6 +14,7 @@
 #include <sphere/fluid/grid.cuh>
 #include <sphere/fluid/poisson.cuh>
 #include <sphere/fluid/poisson_cg.cuh>
+#include <sphere/fluid/poisson_mg.cuh>
 
 #include <omp.h>
 
@@ -228,6 +229,8 @@ template <class Real>
 using jacobi = sphere::jacobi_poisson<Real, sphere::host>;
 template <class Real>
 using cg = sphere::cg_poisson<Real, sphere::host>;
+template <class Real>
+using mg = sphere::mg_poisson<Real, sphere::host>;
 
 #if SPHERE_TEST_HAVE_EIGEN
 /// Both solvers on one grid and set of boundaries against the direct solve.
@@ -257,6 +260,14 @@ void check_against_direct(const sphere::fluid_grid<Real>& g, const poisson_bound
     CHECK(relative_error(g, eps_cg, reference, singular) <= agreement<Real>());
     CHECK(rc.iterations < rj.iterations);
 
+    std::vector<Real> eps_mg = to_real<Real>(p.eps);
+    const poisson_result rm = run<mg<Real>>(g, eps_mg, rhs, bc, st);
+    INFO("MG-PCG: " << rm.iterations << " iterations, residual " << rm.residual);
+    CHECK(rm.converged);
+    CHECK(rm.residual <= st.tolerance);
+    CHECK(relative_error(g, eps_mg, reference, singular) <= agreement<Real>());
+    CHECK(rm.iterations < rc.iterations);
+
     // The Dirichlet layers are never changed.
     const std::vector<Real> start = to_real<Real>(p.eps);
     for (int j = 0; j < int(g.n[1]); ++j)
@@ -268,22 +279,25 @@ void check_against_direct(const sphere::fluid_grid<Real>& g, const poisson_bound
                 const std::size_t f = g.field_index(i, j, k);
                 CHECK(eps[f] == start[f]);
                 CHECK(eps_cg[f] == start[f]);
+                CHECK(eps_mg[f] == start[f]);
             }
 
     // Singular case: zero mean over the cells.
     if (singular) {
-        double mean_j = 0, mean_c = 0, scale = 0;
+        double mean_j = 0, mean_c = 0, mean_m = 0, scale = 0;
         for (std::size_t c = 0; c < g.cell_count(); ++c) {
             int i, j, k;
             g.coordinates(c, i, j, k);
             const std::size_t f = g.field_index(i, j, k);
             mean_j += double(eps[f]);
             mean_c += double(eps_cg[f]);
+            mean_m += double(eps_mg[f]);
             scale = std::max(scale, std::abs(reference[f]));
         }
         const double eps_mean = sizeof(Real) == sizeof(double) ? 1e-13 : 1e-6;
         CHECK(std::abs(mean_j / double(g.cell_count())) <= eps_mean * scale);
         CHECK(std::abs(mean_c / double(g.cell_count())) <= eps_mean * scale);
+        CHECK(std::abs(mean_m / double(g.cell_count())) <= eps_mean * scale);
     }
 }
 
@@ -390,10 +404,11 @@ TEMPLATE_TEST_CASE("A fluid at rest converges in 0 iterations with both criteria
             poisson_settings st;
             st.criterion = criterion;
             const std::vector<Real> rhs(g.field_size(), Real(0));
-            std::vector<Real> e1(g.field_size(), Real(0)), e2(g.field_size(), Real(0));
+            std::vector<Real> e1(g.field_size(), Real(0)), e2(g.field_size(), Real(0)), e3(g.field_size(), Real(0));
             const poisson_result rj = run<jacobi<Real>>(g, e1, rhs, bc, st);
             const poisson_result rc = run<cg<Real>>(g, e2, rhs, bc, st);
-            for (const poisson_result& r : {rj, rc}) {
+            const poisson_result rm = run<mg<Real>>(g, e3, rhs, bc, st);
+            for (const poisson_result& r : {rj, rc, rm}) {
                 CHECK(r.iterations == 0);
                 CHECK(r.converged);
                 CHECK(r.residual == 0);
@@ -401,6 +416,7 @@ TEMPLATE_TEST_CASE("A fluid at rest converges in 0 iterations with both criteria
             for (std::size_t f = 0; f < g.field_size(); ++f) {
                 CHECK(e1[f] == Real(0));
                 CHECK(e2[f] == Real(0));
+                CHECK(e3[f] == Real(0));
             }
         }
 }
@@ -420,10 +436,11 @@ TEMPLATE_TEST_CASE("A solved field is accepted in 0 iterations and the limit is 
             st.tolerance = 1e-10;
             st.max_iterations = 5;
             st.criterion = criterion;
-            std::vector<Real> e1 = to_real<Real>(p.eps), e2 = to_real<Real>(p.eps);
+            std::vector<Real> e1 = to_real<Real>(p.eps), e2 = to_real<Real>(p.eps), e3 = to_real<Real>(p.eps);
             const poisson_result rj = run<jacobi<Real>>(g, e1, rhs, mixed, st);
             const poisson_result rc = run<cg<Real>>(g, e2, rhs, mixed, st);
-            for (const poisson_result& r : {rj, rc}) {
+            const poisson_result rm = run<mg<Real>>(g, e3, rhs, mixed, st);
+            for (const poisson_result& r : {rj, rc, rm}) {
                 CHECK_FALSE(r.converged);
                 CHECK(r.iterations == 5);
                 CHECK(std::isfinite(r.residual));
@@ -447,6 +464,10 @@ TEMPLATE_TEST_CASE("A solved field is accepted in 0 iterations and the limit is 
         const poisson_result rc = run<cg<Real>>(g, e, rhs, mixed, st);
         CHECK(rc.iterations == 0);
         CHECK(rc.converged);
+        CHECK(e == solved);
+        const poisson_result rm = run<mg<Real>>(g, e, rhs, mixed, st);
+        CHECK(rm.iterations == 0);
+        CHECK(rm.converged);
         CHECK(e == solved);
     }
     SECTION("normalized_change: the seeds' criterion converges, and relative change stays consistent")
@@ -494,9 +515,11 @@ TEMPLATE_TEST_CASE("Poisson solvers refuse bad settings and NaN input", "[fluid]
     std::vector<Real> e = to_real<Real>(p.eps);
     jacobi<Real> js(g);
     cg<Real> cs(g);
+    mg<Real> ms(g);
     auto both = [&](const poisson_boundaries& bc, const poisson_settings& st, const std::string& message) {
         CHECK_THROWS_WITH(js.solve(e.data(), rhs.data(), bc, st), Catch::Contains(message));
         CHECK_THROWS_WITH(cs.solve(e.data(), rhs.data(), bc, st), Catch::Contains(message));
+        CHECK_THROWS_WITH(ms.solve(e.data(), rhs.data(), bc, st), Catch::Contains(message));
     };
     poisson_settings st;
     st.tolerance = 0;
@@ -514,10 +537,12 @@ TEMPLATE_TEST_CASE("Poisson solvers refuse bad settings and NaN input", "[fluid]
     const auto thin = make_grid<Real>(4, 4, 2, 0.4, 0.4, 0.2);
     jacobi<Real> jt(thin);
     cg<Real> ct(thin);
+    mg<Real> mt(thin);
     std::vector<Real> et(thin.field_size(), Real(0)), rt(thin.field_size(), Real(1));
     for (const poisson_boundaries& bc : {dirichlet_both, mixed, mixed_other}) {
         CHECK_THROWS_WITH(jt.solve(et.data(), rt.data(), bc, poisson_settings{}), Catch::Contains("nz = 2 cells"));
         CHECK_THROWS_WITH(ct.solve(et.data(), rt.data(), bc, poisson_settings{}), Catch::Contains("needs nz >= 3"));
+        CHECK_THROWS_WITH(mt.solve(et.data(), rt.data(), bc, poisson_settings{}), Catch::Contains("needs nz >= 3"));
     }
     CHECK_NOTHROW(jt.solve(et.data(), rt.data(), neumann_both, poisson_settings{}));
 
@@ -550,26 +575,31 @@ TEMPLATE_TEST_CASE("Poisson solves are bit-identical when repeated", "[fluid][po
         st.max_iterations = 2000;
         jacobi<Real> js(g);
         cg<Real> cs(g);
+        mg<Real> ms(g);
         std::vector<std::vector<Real>> out;
         for (int run_index = 0; run_index < 2; ++run_index) {
-            std::vector<Real> e1 = to_real<Real>(p.eps), e2 = to_real<Real>(p.eps), e3 = to_real<Real>(p.eps);
+            std::vector<Real> e1 = to_real<Real>(p.eps), e2 = to_real<Real>(p.eps), e3 = to_real<Real>(p.eps),
+                              e4 = to_real<Real>(p.eps), e5 = to_real<Real>(p.eps);
             js.solve(e1.data(), rhs.data(), bc, st);
             cs.solve(e2.data(), rhs.data(), bc, st);
             // A fresh solver after the reused one solved other boundaries.
             run<cg<Real>>(g, e3, rhs, bc, st);
-            out.push_back(e1);
-            out.push_back(e2);
-            out.push_back(e3);
+            ms.solve(e4.data(), rhs.data(), bc, st);
+            run<mg<Real>>(g, e5, rhs, bc, st);
+            for (auto* e : {&e1, &e2, &e3, &e4, &e5}) out.push_back(*e);
             // Reuse the solvers on other boundaries before the second round.
             std::vector<Real> other = to_real<Real>(p.eps);
             js.solve(other.data(), rhs.data(), dirichlet_both, st);
             cs.solve(other.data(), rhs.data(), dirichlet_both, st);
+            ms.solve(other.data(), rhs.data(), dirichlet_both, st);
         }
         const std::size_t bytes = g.field_size() * sizeof(Real);
-        CHECK(std::memcmp(out[0].data(), out[3].data(), bytes) == 0);
-        CHECK(std::memcmp(out[1].data(), out[4].data(), bytes) == 0);
-        CHECK(std::memcmp(out[2].data(), out[5].data(), bytes) == 0);
+        for (std::size_t i = 0; i < 5; ++i) {
+            INFO("solve " << i);
+            CHECK(std::memcmp(out[i].data(), out[i + 5].data(), bytes) == 0);
+        }
         CHECK(std::memcmp(out[1].data(), out[2].data(), bytes) == 0);
+        CHECK(std::memcmp(out[3].data(), out[4].data(), bytes) == 0);
     }
 }
 
@@ -583,18 +613,20 @@ TEMPLATE_TEST_CASE("Poisson solvers fill the ghost nodes on return", "[fluid][po
         const std::vector<Real> rhs = to_real<Real>(p.rhs);
         poisson_settings st;
         st.tolerance = 1e-4;
-        std::vector<Real> e1 = to_real<Real>(p.eps), e2 = to_real<Real>(p.eps);
+        std::vector<Real> e1 = to_real<Real>(p.eps), e2 = to_real<Real>(p.eps), e3 = to_real<Real>(p.eps);
         // Garbage in the ghosts on entry: the solvers must not depend on it.
         for (std::size_t f = 0; f < g.field_size(); ++f) {
             int i = int(f % (g.n[0] + 2)) - 1, j = int(f / (g.n[0] + 2) % (g.n[1] + 2)) - 1,
                 k = int(f / ((g.n[0] + 2) * (g.n[1] + 2))) - 1;
             if (i < 0 || j < 0 || k < 0 || i >= int(g.n[0]) || j >= int(g.n[1]) || k >= int(g.n[2]))
-                e1[f] = e2[f] = Real(1e6);
+                e1[f] = e2[f] = e3[f] = Real(1e6);
         }
         REQUIRE(run<jacobi<Real>>(g, e1, rhs, bc, st).converged);
         REQUIRE(run<cg<Real>>(g, e2, rhs, bc, st).converged);
+        REQUIRE(run<mg<Real>>(g, e3, rhs, bc, st).converged);
         check_ghosts(g, e1, bc);
         check_ghosts(g, e2, bc);
+        check_ghosts(g, e3, bc);
     }
 }
 
@@ -624,25 +656,26 @@ TEMPLATE_TEST_CASE("Poisson solves are bit-identical on 1 and 2 OpenMP threads",
             poisson_settings st;
             st.tolerance = 1e-12; // not reached: every solve stops at the limit
             st.max_iterations = 20;
-            std::vector<Real> e1 = to_real<Real>(p.eps), e2 = to_real<Real>(p.eps), e3 = to_real<Real>(p.eps);
+            std::vector<Real> e1 = to_real<Real>(p.eps), e2 = to_real<Real>(p.eps), e3 = to_real<Real>(p.eps),
+                              e4 = to_real<Real>(p.eps);
             results.push_back(run<jacobi<Real>>(g, e1, rhs, bc, st));
             st.criterion = poisson_criterion::normalized_change;
             results.push_back(run<jacobi<Real>>(g, e2, rhs, bc, st));
             st.criterion = poisson_criterion::relative_residual;
             st.max_iterations = 30;
             results.push_back(run<cg<Real>>(g, e3, rhs, bc, st));
-            out.push_back(e1);
-            out.push_back(e2);
-            out.push_back(e3);
+            st.max_iterations = 4;
+            results.push_back(run<mg<Real>>(g, e4, rhs, bc, st));
+            for (auto* e : {&e1, &e2, &e3, &e4}) out.push_back(*e);
         }
         const std::size_t bytes = g.field_size() * sizeof(Real);
-        for (std::size_t i = 0; i < 3; ++i) {
+        for (std::size_t i = 0; i < 4; ++i) {
             INFO("solve " << i);
-            CHECK(std::memcmp(out[i].data(), out[i + 3].data(), bytes) == 0);
-            CHECK(std::memcmp(out[i].data(), out[i + 6].data(), bytes) == 0);
-            CHECK(results[i].iterations == results[i + 3].iterations);
-            CHECK(std::memcmp(&results[i].residual, &results[i + 3].residual, sizeof(double)) == 0);
-            CHECK(std::memcmp(&results[i].residual, &results[i + 6].residual, sizeof(double)) == 0);
+            CHECK(std::memcmp(out[i].data(), out[i + 4].data(), bytes) == 0);
+            CHECK(std::memcmp(out[i].data(), out[i + 8].data(), bytes) == 0);
+            CHECK(results[i].iterations == results[i + 4].iterations);
+            CHECK(std::memcmp(&results[i].residual, &results[i + 4].residual, sizeof(double)) == 0);
+            CHECK(std::memcmp(&results[i].residual, &results[i + 8].residual, sizeof(double)) == 0);
         }
     }
 }
@@ -670,9 +703,14 @@ TEST_CASE("Singular case: a right-hand side of large mean and a guess of large o
         poisson_settings st;
         st.tolerance = 1e-10;
         st.max_iterations = 20000;
-        std::vector<Real> ej = eps, ec = eps;
+        std::vector<Real> ej = eps, ec = eps, em = eps;
         const poisson_result rj = run<jacobi<Real>>(g, ej, rhs, neumann_both, st);
         const poisson_result rc = run<cg<Real>>(g, ec, rhs, neumann_both, st);
+        const poisson_result rm = run<mg<Real>>(g, em, rhs, neumann_both, st);
+        INFO("MG-PCG: " << rm.iterations << " iterations, residual " << rm.residual);
+        CHECK(rm.converged);
+        CHECK(rm.residual <= 1e-10);
+        CHECK(relative_error(g, em, ej, true) < 1e-8);
         INFO("Jacobi: " << rj.iterations << " sweeps, residual " << rj.residual);
         INFO("CG: " << rc.iterations << " iterations, residual " << rc.residual);
         CHECK(rj.converged);
@@ -691,4 +729,56 @@ TEST_CASE("Singular case: a right-hand side of large mean and a guess of large o
         }
         CHECK(std::abs(mean) <= 1e-12 * scale);
     }
+}
+
+// Multigrid-preconditioned CG: iterations that do not grow with the grid. Pseudo-random
+// right-hand side on n^3 cubic cells (periodic x, y), relative residual 1e-8, double. Measured:
+// 9 iterations at 32^3, 64^3 and 128^3 with every pair of z boundaries (bench/bench_fluid.cpp
+// times it against CG).
+TEST_CASE("MG-PCG iteration counts are independent of the grid: 32^3, 64^3, 128^3", "[fluid][poisson][slow]")
+{
+    using Real = double;
+    for (const poisson_boundaries& bc : {neumann_both, mixed, dirichlet_both}) {
+        std::vector<unsigned> counts;
+        for (int n : {32, 64, 128}) {
+            const auto g = make_grid<Real>(n, n, n, 1.0, 1.0, 1.0);
+            const problem p = make_problem(g, bc, 300.0, 71);
+            const std::vector<Real> rhs = to_real<Real>(p.rhs);
+            std::vector<Real> e = to_real<Real>(p.eps);
+            poisson_settings st;
+            st.tolerance = 1e-8;
+            const poisson_result r = run<mg<Real>>(g, e, rhs, bc, st);
+            INFO(describe(bc) << ", " << n << "^3: " << r.iterations << " iterations, residual " << r.residual);
+            CHECK(r.converged);
+            CHECK(r.residual <= 1e-8);
+            CHECK(r.iterations <= 15);
+            counts.push_back(r.iterations);
+        }
+        INFO(describe(bc) << ": " << counts[0] << ", " << counts[1] << ", " << counts[2] << " iterations");
+        const unsigned lo = *std::min_element(counts.begin(), counts.end()),
+                       hi = *std::max_element(counts.begin(), counts.end());
+        CHECK(double(hi) <= 1.2 * double(lo));
+    }
+}
+
+TEMPLATE_TEST_CASE("MG-PCG's levels coarsen even counts by halves and odd layer counts by every second layer",
+                   "[fluid][poisson]", float, double)
+{
+    using Real = TestType;
+    // 12 x 10 x 16 cells: x 12 -> 6 -> 3, y 10 -> 5, z with a Dirichlet top (15 unknown layers)
+    // 15 -> 7 -> 3 -> 1; with Neumann ends 16 -> 8 -> 4 -> 2.
+    const auto g = make_grid<Real>(12, 10, 16, 1.2, 1.0, 1.6);
+    mg<Real> solver(g);
+    const problem p = make_problem(g, mixed, 10.0, 81);
+    std::vector<Real> e = to_real<Real>(p.eps);
+    const std::vector<Real> rhs = to_real<Real>(p.rhs);
+    poisson_settings st;
+    st.tolerance = sizeof(Real) == sizeof(double) ? 1e-8 : 1e-4;
+    REQUIRE(solver.solve(e.data(), rhs.data(), mixed, st).converged);
+    const std::vector<std::vector<unsigned>> mixed_levels = {{12, 10, 15}, {6, 5, 7}, {3, 5, 3}, {3, 5, 1}};
+    CHECK(solver.level_sizes() == mixed_levels);
+    e = to_real<Real>(p.eps);
+    REQUIRE(solver.solve(e.data(), rhs.data(), neumann_both, st).converged);
+    const std::vector<std::vector<unsigned>> neumann_levels = {{12, 10, 16}, {6, 5, 8}, {3, 5, 4}, {3, 5, 2}};
+    CHECK(solver.level_sizes() == neumann_levels);
 }

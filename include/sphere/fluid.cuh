@@ -11,4 +11,5 @@
 #include "fluid/navier_stokes.cuh"
 #include "fluid/poisson.cuh"
 #include "fluid/poisson_cg.cuh"
+#include "fluid/poisson_mg.cuh"
 #include "fluid/porosity.cuh"

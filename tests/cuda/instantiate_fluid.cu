@@ -1,5 +1,5 @@
 // Instantiates every kernel of the pore fluid for sphere::cuda in float and double: the
-// porosity estimator, both Poisson solvers, the Navier-Stokes solver with each, and the
+// porosity estimator, the three Poisson solvers, the Navier-Stokes solver with each, and the
 // coupling with each drag law (and once with velocity Verlet, whose coupled step predicts its
 // next drift), so that CI proves the fluid's CUDA backend compiles and links.
 // It is built, not run: build machines have no GPU.
@@ -42,8 +42,10 @@ double exercise_all()
     namespace drag = sphere::drag;
     using jacobi = sphere::jacobi_poisson<Real, sphere::cuda>;
     using cg = sphere::cg_poisson<Real, sphere::cuda>;
+    using mg = sphere::mg_poisson<Real, sphere::cuda>;
     return exercise<Real, drag::gidaspow, jacobi>() + exercise<Real, drag::gidaspow_blended, cg>() +
            exercise<Real, drag::ergun, cg>() + exercise<Real, drag::wen_yu, jacobi>() +
+           exercise<Real, drag::gidaspow, mg>() +
            exercise<Real, drag::gidaspow, cg, sphere::integrate::velocity_verlet>();
 }
 

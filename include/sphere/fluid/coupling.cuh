@@ -148,7 +148,7 @@ struct add_work {
 
 /// The pore fluid coupled to a simulation's particles. `Drag` is a drag law of sphere::drag,
 /// `Poisson` the pressure solver.
-template <class Real, class Policy, class Drag = drag::gidaspow, class Poisson = cg_poisson<Real, Policy>>
+template <class Real, class Policy, class Drag = drag::gidaspow, class Poisson = mg_poisson<Real, Policy>>
 class fluid_coupling {
 public:
     fluid_coupling(const fluid_grid<Real>& g, const fluid_params<Real>& params, const coupling_options& options = {})

@@ -23,6 +23,7 @@
 #include "grid.cuh"
 #include "poisson.cuh"
 #include "poisson_cg.cuh"
+#include "poisson_mg.cuh"
 #include "porosity.cuh"
 
 namespace sphere {
@@ -392,8 +393,10 @@ struct fluid_commit {
 
 } // namespace detail
 
-/// The pore-fluid solver. `Poisson` is the pressure solver: cg_poisson (default; conjugate
-/// gradients) or jacobi_poisson (the seeds' method, 50-100x slower on 16^3-32^3 grids).
+/// The pore-fluid solver. `Poisson` is the pressure solver: mg_poisson (default; conjugate
+/// gradients with a multigrid preconditioner), cg_poisson (plain conjugate gradients, as fast
+/// on small grids in time stepping) or jacobi_poisson (the seeds' method, 50-100x slower than
+/// CG on 16^3-32^3 grids).
 ///
 /// Each `step(dt)` advances the fluid from t to t + dt with the porosity, its rate and the
 /// interaction force it was last given (set_porosity, interaction_force): a fluid on its own
@@ -406,10 +409,11 @@ struct fluid_commit {
 /// A step waits for the device once: its checks and the pressure solve's decisions are
 /// taken on the device (detail::fluid_report, detail::poisson_control), the kernels that
 /// advance the fields run only if they passed, and the host reads the report back at the end
-/// (twice or more only when the solve needs more passes than the last one and a quarter).
+/// (twice or more only when the solve needs more passes than the larger of the last two and a
+/// quarter).
 /// Its reductions and read-back go through the solver's own execution context; its kernels run
 /// on the default stream, which the context's (blocking) stream stays ordered with.
-template <class Real, class Policy, class Poisson = cg_poisson<Real, Policy>>
+template <class Real, class Policy, class Poisson = mg_poisson<Real, Policy>>
 class navier_stokes {
 public:
     navier_stokes(const fluid_grid<Real>& g, const fluid_params<Real>& params)

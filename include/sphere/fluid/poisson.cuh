@@ -471,10 +471,10 @@ struct poisson_control {
     double b_norm;    ///< ||b_u|| (relative_residual)
     double threshold; ///< CG: tolerance x b_norm (x 1 when b_norm = 0), where it checks the true residual
     // Reductions of the current pass, valid where the flag that launched them is set.
-    double sum, sum2;
+    double sum, sum2, sum3; ///< sum3: multigrid-preconditioned CG's r.z
     normalized_change_parts change;
-    // Conjugate gradients: r.r, the step, the direction's beta, the mean projected out of r,
-    // the best true residual so far and the checks since it halved.
+    // Conjugate gradients: r.r (r.z with a preconditioner), the step, the direction's beta,
+    // the mean projected out of r, the best true residual so far and the checks since it halved.
     double rr, alpha, beta, mean, best;
     unsigned stalls;
     int active;      ///< the loop goes on
@@ -541,7 +541,7 @@ struct poisson_begin {
         c->max_iterations = max_iterations;
         c->relative = relative;
         c->shift.hi = c->shift.lo = 0;
-        c->b_norm = c->threshold = c->sum = c->sum2 = 0;
+        c->b_norm = c->threshold = c->sum = c->sum2 = c->sum3 = 0;
         c->change = normalized_change_parts{0.0, 0.0, 0.0};
         c->rr = c->alpha = c->beta = c->mean = c->best = 0;
         c->stalls = 0;
@@ -855,12 +855,19 @@ private:
     bool relative_ = true;
 };
 
-/// How many passes a solve launches before it first reads its control back: the passes the
-/// last solve used, a quarter more and 4, at least `first`; a solve that has not finished
-/// doubles it for the next launch.
+/// How many passes a solve launches before it first reads its control back: the most passes
+/// either of the last two solves used, a quarter more and 4, at least 16 (counts that
+/// alternate, as Jacobi's do from one fluid step to the next with a steady source, still read
+/// back once); a solve that has not finished doubles it for the next launch.
 struct poisson_budget {
     unsigned passes = 16;
-    void learn(unsigned used) { passes = used + used / 4 + 4 < 16 ? 16 : used + used / 4 + 4; }
+    unsigned previous = 0; ///< the passes the solve before the last one used
+    void learn(unsigned used)
+    {
+        const unsigned most = used > previous ? used : previous;
+        previous = used;
+        passes = most + most / 4 + 4 < 16 ? 16 : most + most / 4 + 4;
+    }
 };
 
 /// What both solvers share (CRTP: `Derived` is jacobi_poisson or cg_poisson): the problem,
@@ -1005,8 +1012,8 @@ struct jacobi_after_sweep {
 ///
 /// The loop runs on the device without waiting (detail::poisson_control): a pass is a sweep
 /// (into the scratch field, then back), decided on the device; `solve` launches as many
-/// passes as the last solve needed and a quarter more, reads the control back once, and only
-/// launches more (doubling) if the solve had not finished.
+/// passes as the larger of the last two solves needed and a quarter more, reads the control
+/// back once, and only launches more (doubling) if the solve had not finished.
 ///
 /// Owns one scratch field (the other iterate), allocated once. Usage:
 ///

@@ -272,9 +272,10 @@ struct cg_after_restart {
 ///
 /// The loop runs on the device without waiting (detail::poisson_control): each pass is the
 /// body of the loop above, its branches decided by one-thread kernels and taken by kernels
-/// guarded by the control's flags; `solve` launches as many passes as the last solve needed
-/// and a quarter more, reads the control back once, and only launches more (doubling) if the
-/// solve had not finished. On the host a guarded kernel whose flag is 0 is not started.
+/// guarded by the control's flags; `solve` launches as many passes as the larger of the last
+/// two solves needed and a quarter more, reads the control back once, and only launches more
+/// (doubling) if the solve had not finished. On the host a guarded kernel whose flag is 0 is
+/// not started.
 ///
 /// Owns three scratch fields (residual r, direction p, A p), allocated once.
 template <class Real, class Policy>
