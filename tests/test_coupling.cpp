@@ -4,7 +4,8 @@
 //   velocity for its cell's porosity, with buoyancy from the pressure gradient, and the larger
 //   one without it; its energy changes by the work the fluid did on it;
 // - F8: the pressure drop through a fixed bed follows Ergun for the porosity the code computed,
-//   and phi times Ergun when the pressure force is not exchanged;
+//   and phi times Ergun when the pressure force is not exchanged; driven by a prescribed inflow
+//   at the bottom, the bed carries that flux and the pressure drops by Ergun's gradient;
 // - F10: particles moving through a fluid at rest exchange x-momentum with it, conserving the
 //   total within 1%, and share the common final velocity;
 // - hindered settling in a closed box: the fluid's flux through mid-height equals the
@@ -186,6 +187,71 @@ TEMPLATE_TEST_CASE("F8: the pressure drop through a fixed bed follows Ergun for 
         CHECK(U < 3e-3);
         CHECK(gradient == Approx(pressure_force ? ergun : phi_bed * ergun).epsilon(0.02));
     }
+}
+
+TEMPLATE_TEST_CASE("inflow through a fixed bed: the prescribed superficial velocity and Ergun's pressure drop",
+                   "[coupling][F8]", float, double)
+{
+    using Real = TestType;
+    // F8's bed (simple cubic, d = 1 mm, solid fraction pi/6, cells of 2 mm), driven by a
+    // prescribed superficial velocity U = 1 mm/s at the bottom with p = 0 on the top layer
+    // instead of by two pressures: the flux through every interior face is U, and the pressure
+    // drops by Ergun's gradient at U (VALIDATION F8: 860.156 Pa/m at phi = 0.4; here phi =
+    // 1 - pi/6, 2%).
+    const double d = 1e-3, cell = 2e-3, mu = 1e-3, rho = 1000, U = 1e-3;
+    const int nz = 12;
+    sphere::settings<Real> s = periodic_column<Real>(4 * cell, 4 * cell, nz * cell, 1e-4);
+    s.dt = Real(5e-4);
+    std::vector<sphere::particle<Real>> bed;
+    for (int k = 0; k < 2 * nz - 1; ++k)
+        for (int j = 0; j < 8; ++j)
+            for (int i = 0; i < 8; ++i) {
+                sphere::particle<Real> p;
+                p.position = {Real((i + 0.5) * d), Real((j + 0.5) * d), Real((k + 0.5) * d)};
+                p.radius = Real(d / 2);
+                p.density = 2600;
+                p.kind = sphere::motion::fixed;
+                bed.push_back(p);
+            }
+    sim_t<Real> sim(s, bed);
+    sphere::fluid_params<Real> prm;
+    prm.density = Real(rho);
+    prm.viscosity = Real(mu);
+    prm.bottom = sphere::fluid_boundary<Real>::inflow(Real(U));
+    prm.top = sphere::fluid_boundary<Real>::prescribed_pressure(0);
+    prm.poisson.tolerance = sizeof(Real) == 8 ? 1e-10 : 1e-4;
+    sphere::coupling_options opt;
+    opt.dem_steps = 1;
+    coupling_t<Real, sphere::drag::ergun> coupled(sphere::fluid_grid<Real>::make(s.box, 4, 4, nz), prm, opt);
+    for (int n = 0; n < 100; ++n) coupled.step(sim);
+
+    const auto& grid = coupled.fluid().grid();
+    const auto p = coupled.fluid().pressure();
+    const auto w = coupled.fluid().face_velocity(2);
+    const auto phi = coupled.fluid().porosity();
+    double phi_bed = 0, count = 0;
+    for (int k = 2; k < nz - 3; ++k)
+        for (int j = 0; j < 4; ++j)
+            for (int i = 0; i < 4; ++i) {
+                const std::size_t c = grid.field_index(i, j, k);
+                const double phi_f = 0.5 * (phi[c] + phi[grid.field_index(i, j, k + 1)]);
+                CHECK(phi_f * double(w[c]) == Approx(U).epsilon(sizeof(Real) == 8 ? 1e-8 : 1e-3));
+                phi_bed += phi[c];
+                count += 1;
+            }
+    phi_bed /= count;
+    double p_lo = 0, p_hi = 0;
+    for (int j = 0; j < 4; ++j)
+        for (int i = 0; i < 4; ++i) {
+            p_lo += double(p[grid.field_index(i, j, 2)]) / 16;
+            p_hi += double(p[grid.field_index(i, j, nz - 3)]) / 16;
+        }
+    const double gradient = (p_lo - p_hi) / ((nz - 5) * cell);
+    const double ergun = 150 * mu * (1 - phi_bed) * (1 - phi_bed) * U / (phi_bed * phi_bed * phi_bed * d * d) +
+                         1.75 * (1 - phi_bed) * rho * U * U / (phi_bed * phi_bed * phi_bed * d);
+    INFO("porosity " << phi_bed << ", -dp/dz = " << gradient << " Pa/m, Ergun " << ergun);
+    CHECK(phi_bed == Approx(1 - pi / 6).epsilon(1e-4));
+    CHECK(gradient == Approx(ergun).epsilon(0.02));
 }
 
 TEMPLATE_TEST_CASE("F10: particles and fluid exchange x-momentum and conserve it", "[coupling][F10]", float, double)

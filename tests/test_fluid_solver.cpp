@@ -6,6 +6,8 @@
 // - F4: a pressure difference between two prescribed-pressure layers accelerates the fluid
 //   uniformly, with a linear pressure;
 // - F5: a decaying shear wave decays at the rate of the discrete (3-point) viscous operator;
+// - an inflow bottom (a prescribed superficial velocity) with a prescribed top pressure carries
+//   its flux through every layer, whatever the porosity;
 // - the time-step limits, a non-converged pressure solve and bad parameters are errors;
 // - both Poisson solvers give the same flow.
 #include <catch2/catch.hpp>
@@ -181,6 +183,75 @@ TEMPLATE_TEST_CASE("F5: a shear wave decays at the rate of the discrete viscous 
                 pmin = std::min(pmin, double(p[g.field_index(i, j, kz)]));
             }
     CHECK(pmax - pmin < tolerance<Real>(1e-9, 1e-4));
+}
+
+TEMPLATE_TEST_CASE("inflow: a prescribed superficial velocity at the bottom, the pressure at the top", "[fluid]", float,
+                   double)
+{
+    using Real = TestType;
+    // U = 2 mm/s enters a 4 x 4 x 10 column at the bottom and leaves through the prescribed
+    // top layer, under gravity. Without a porosity (phi = 1) the flow is uniform at once: every
+    // z face carries w = U and the pressure is hydrostatic. With a porosity that varies from layer
+    // to layer (held, no particles) the superficial velocity phi_f w is U on every z face
+    // (continuity), the interstitial w = U / phi_f.
+    const double U = 2e-3, rho = 1000, grav = 9.81;
+    const auto g = column_grid<Real>(4, 4, 10, Real(0.4), Real(0.4), Real(1));
+    sphere::fluid_params<Real> prm;
+    prm.density = Real(rho);
+    prm.viscosity = Real(1e-3);
+    prm.gravity = {0, 0, Real(-grav)};
+    prm.bottom = sphere::fluid_boundary<Real>::inflow(Real(U));
+    prm.top = sphere::fluid_boundary<Real>::prescribed_pressure(0);
+    prm.poisson.tolerance = sizeof(Real) == 8 ? 1e-12 : 1e-5;
+    for (bool porous : {false, true}) {
+        CAPTURE(porous);
+        sphere::navier_stokes<Real, sphere::host> fluid(g, prm);
+        std::vector<Real> phi(g.field_size(), Real(1)), rate(g.field_size(), Real(0)), d(g.field_size(), Real(0));
+        std::vector<vec3<Real>> v(g.field_size(), vec3<Real>{0, 0, 0});
+        if (porous)
+            for (int k = 0; k < 10; ++k)
+                for (int j = 0; j < 4; ++j)
+                    for (int i = 0; i < 4; ++i) phi[g.field_index(i, j, k)] = Real(0.45 + 0.05 * (k % 3));
+        fluid.set_porosity(sphere::porosity_view<Real>{g, Real(0.05), phi.data(), rate.data(), v.data(), d.data()});
+        for (int n = 0; n < 20; ++n) fluid.step(Real(1e-3));
+        const auto w = fluid.face_velocity(2);
+        const auto por = fluid.porosity();
+        // The inflow face and the faces between cells (the top face, above the prescribed
+        // layer, copies the face below it).
+        for (int k = -1; k < 9; ++k)
+            for (int j = 0; j < 4; ++j)
+                for (int i = 0; i < 4; ++i) {
+                    CAPTURE(i, j, k);
+                    // The face's porosity: the mean of its two cells (the inflow face: the end cell's).
+                    const double below = double(por[g.field_index(i, j, k < 0 ? 0 : k)]);
+                    const double above = double(por[g.field_index(i, j, k + 1 > 9 ? 9 : k + 1)]);
+                    const double phi_f = 0.5 * (below + above);
+                    CHECK(phi_f * double(w[g.field_index(i, j, k)]) == Approx(U).epsilon(tolerance<Real>(1e-9, 2e-4)));
+                }
+        for (int a = 0; a < 2; ++a)
+            for (Real u : fluid.face_velocity(a)) CHECK(std::fabs(double(u)) < tolerance<Real>(1e-12, 1e-6));
+        if (!porous) {
+            const auto p = fluid.pressure();
+            for (int k = 0; k < 10; ++k) {
+                CAPTURE(k);
+                CHECK(double(p[g.field_index(2, 1, k)]) ==
+                      Approx(rho * grav * (0.95 - (k + 0.5) * 0.1)).margin(tolerance<Real>(1e-6, 1e-3) * rho * grav));
+            }
+        }
+    }
+
+    // An inflow end needs the pressure prescribed at the other end; a velocity must be finite.
+    sphere::fluid_params<Real> bad = prm;
+    bad.top = sphere::fluid_boundary<Real>::no_flow();
+    CHECK_THROWS_WITH((sphere::navier_stokes<Real, sphere::host>(g, bad)),
+                      Catch::Contains("fluid: an inflow bottom (velocity 0.002") &&
+                          Catch::Contains("m/s) needs a prescribed pressure at the top") && Catch::Contains("it is no_flow"));
+    bad.top = sphere::fluid_boundary<Real>::inflow(Real(U));
+    CHECK_THROWS_WITH((sphere::navier_stokes<Real, sphere::host>(g, bad)), Catch::Contains("it is inflow"));
+    bad = prm;
+    bad.bottom = sphere::fluid_boundary<Real>::inflow(std::numeric_limits<Real>::infinity());
+    CHECK_THROWS_WITH((sphere::navier_stokes<Real, sphere::host>(g, bad)),
+                      Catch::Contains("fluid: bottom.velocity = inf m/s is not finite"));
 }
 
 TEMPLATE_TEST_CASE("the fluid solver refuses unstable time steps, unconverged solves and bad parameters", "[fluid]", float,

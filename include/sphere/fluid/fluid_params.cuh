@@ -15,11 +15,15 @@ namespace sphere {
 enum class fluid_boundary_kind {
     no_flow,  ///< an impermeable, free-slip wall at the face of the grid (zero normal gradient of
               ///< the pressure increment; zero normal velocity)
-    pressure  ///< a prescribed pressure held at the centres of the outermost cell layer (drained)
+    pressure, ///< a prescribed pressure held at the centres of the outermost cell layer (drained)
+    inflow    ///< a prescribed superficial velocity through the face of the grid (zero normal
+              ///< gradient of the pressure increment); the other end must prescribe the pressure
 };
 
 /// One z end of the fluid grid. For `pressure`, the value at time t is
 ///   p(t) = pressure + amplitude sin(2 pi frequency t + phase)   (Pa).
+/// For `inflow`, `velocity` is the superficial velocity U = phi w through the end face (m/s,
+/// along +z at either end: U > 0 at the bottom brings fluid in, at the top takes it out).
 template <class Real>
 struct fluid_boundary {
     fluid_boundary_kind kind = fluid_boundary_kind::no_flow;
@@ -27,6 +31,7 @@ struct fluid_boundary {
     Real amplitude = 0;  ///< amplitude of its sinusoidal modulation (Pa)
     Real frequency = 0;  ///< modulation frequency (Hz)
     Real phase = 0;      ///< modulation phase (rad)
+    Real velocity = 0;   ///< inflow: superficial velocity along +z (m/s)
 
     Real value(double t) const
     {
@@ -36,7 +41,12 @@ struct fluid_boundary {
     static fluid_boundary no_flow() { return {}; }
     static fluid_boundary prescribed_pressure(Real p, Real amplitude = 0, Real frequency = 0, Real phase = 0)
     {
-        return {fluid_boundary_kind::pressure, p, amplitude, frequency, phase};
+        return {fluid_boundary_kind::pressure, p, amplitude, frequency, phase, Real(0)};
+    }
+    /// A prescribed superficial velocity U (m/s, along +z) through the end face.
+    static fluid_boundary inflow(Real superficial_velocity)
+    {
+        return {fluid_boundary_kind::inflow, Real(0), Real(0), Real(0), Real(0), superficial_velocity};
     }
 };
 
@@ -67,14 +77,19 @@ struct fluid_params {
         const char* names[2] = {"bottom", "top"};
         for (int e = 0; e < 2; ++e) {
             const auto& b = *ends[e];
-            const Real values[4] = {b.pressure, b.amplitude, b.frequency, b.phase};
-            const char* fields[4] = {"pressure", "amplitude", "frequency", "phase"};
-            const char* units[4] = {" Pa", " Pa", " Hz", " rad"};
-            for (int k = 0; k < 4; ++k)
+            const Real values[5] = {b.pressure, b.amplitude, b.frequency, b.phase, b.velocity};
+            const char* fields[5] = {"pressure", "amplitude", "frequency", "phase", "velocity"};
+            const char* units[5] = {" Pa", " Pa", " Hz", " rad", " m/s"};
+            for (int k = 0; k < 5; ++k)
                 if (!std::isfinite(values[k]))
                     detail::fail("fluid: ", names[e], ".", fields[k], " = ", values[k], units[k], " is not finite");
             if (b.frequency < 0)
                 detail::fail("fluid: the ", names[e], " boundary frequency = ", b.frequency, " Hz is negative");
+            const fluid_boundary<Real>& other = *ends[1 - e];
+            if (b.kind == fluid_boundary_kind::inflow && other.kind != fluid_boundary_kind::pressure)
+                detail::fail("fluid: an inflow ", names[e], " (velocity ", b.velocity, " m/s) needs a prescribed pressure at the ",
+                             names[1 - e], ", where the fluid can leave or enter; it is ",
+                             other.kind == fluid_boundary_kind::no_flow ? "no_flow" : "inflow");
         }
     }
 };

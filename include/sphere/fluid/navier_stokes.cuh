@@ -9,6 +9,7 @@
 /// velocity component a lives on the faces normal to axis a, face (i, j, k) of axis a being the
 /// one between cell (i, j, k) and its neighbour in +a. All use fluid_grid::field_index (one
 /// ghost layer). Along z, face k = -1 is the bottom of the grid and face nz - 1 its top.
+#include <array>
 #include <cmath>
 #include <cstddef>
 #include <vector>
@@ -39,7 +40,9 @@ struct fluid_view {
     vec3<Real>* force;  ///< interaction force density on the fluid (N/m^3), cells
     long long stride[3];
     Real rho, mu;
-    bool wall_bottom, wall_top;  ///< no-flow ends (else prescribed pressure)
+    bool wall_bottom, wall_top;  ///< no-flow ends (else prescribed pressure or inflow)
+    bool inflow_bottom, inflow_top; ///< inflow ends
+    Real u_bottom, u_top;        ///< their superficial velocities along +z (m/s)
 
     /// fluid_grid::field_index, signed so that neighbours can be reached by subtraction.
     SPHERE_HD long long at(int i, int j, int k) const { return static_cast<long long>(grid.field_index(i, j, k)); }
@@ -116,14 +119,18 @@ struct fill_cell_ghosts {
 };
 
 /// Fills the ghost faces of the three face-velocity fields and sets the z faces at the top and
-/// bottom of the grid: zero on a no-flow wall, a copy of the adjacent inner face at a
-/// prescribed-pressure end. Tangential components are copied from the nearest cell in z (no
-/// shear stress at the ends: free slip).
+/// bottom of the grid: zero on a no-flow wall, U / phi at an inflow end (U the prescribed
+/// superficial velocity, phi the porosity of the end cell), a copy of the adjacent inner face
+/// at a prescribed-pressure end. Tangential components are copied from the nearest cell in z
+/// (no shear stress at the ends: free slip).
 template <class Real>
 struct fill_velocity_ghosts {
     fluid_grid<Real> g;
     Real* u[3];
     bool wall_bottom, wall_top;
+    bool inflow_bottom, inflow_top;
+    Real u_bottom, u_top;
+    const Real* phi; ///< porosity (cells)
 
     SPHERE_HD void operator()(std::size_t node) const
     {
@@ -137,8 +144,12 @@ struct fill_velocity_ghosts {
             ghost_source(g, si, sj, sk);
             const bool bottom = k == -1;
             const bool wall = bottom ? wall_bottom : wall_top;
+            const bool inflow = bottom ? inflow_bottom : inflow_top;
             const int inner = bottom ? 0 : nz - 2;
-            u[2][node] = (wall || nz < 2) ? Real(0) : u[2][g.field_index(si, sj, inner)];
+            if (inflow)
+                u[2][node] = (bottom ? u_bottom : u_top) / phi[g.field_index(si, sj, bottom ? 0 : nz - 1)];
+            else
+                u[2][node] = (wall || nz < 2) ? Real(0) : u[2][g.field_index(si, sj, inner)];
         } else if (ghost) {
             int si = i, sj = j, sk = k;
             ghost_source(g, si, sj, sk);
@@ -456,6 +467,10 @@ public:
         v.mu = params_.viscosity;
         v.wall_bottom = params_.bottom.kind == fluid_boundary_kind::no_flow;
         v.wall_top = params_.top.kind == fluid_boundary_kind::no_flow;
+        v.inflow_bottom = params_.bottom.kind == fluid_boundary_kind::inflow;
+        v.inflow_top = params_.top.kind == fluid_boundary_kind::inflow;
+        v.u_bottom = params_.bottom.velocity;
+        v.u_top = params_.top.velocity;
         return v;
     }
 
@@ -638,8 +653,7 @@ private:
         for_each_index_if(Policy{}, go, grid_.cell_count(),
                           detail::correct_velocity<Real>{view(), {vs[0], vs[1], vs[2]}, eps_.data(), dt, params_.beta});
         const fluid_view<Real> f = view();
-        for_each_index_if(Policy{}, go, grid_.field_size(),
-                          detail::fill_velocity_ghosts<Real>{grid_, {f.u[0], f.u[1], f.u[2]}, f.wall_bottom, f.wall_top});
+        for_each_index_if(Policy{}, go, grid_.field_size(), velocity_ghosts(f, {f.u[0], f.u[1], f.u[2]}));
         for_each_index_if(Policy{}, go, grid_.field_size(), detail::fill_cell_ghosts<Real, Real>{grid_, p_.data(), true});
     }
 
@@ -651,9 +665,12 @@ private:
     void fill_pressure_ghosts() { fill_cell_ghosts(p_, true); }
     void fill_velocity_ghosts(Real* const* u)
     {
-        const fluid_view<Real> f = view();
-        for_each_index(Policy{}, grid_.field_size(),
-                       detail::fill_velocity_ghosts<Real>{grid_, {u[0], u[1], u[2]}, f.wall_bottom, f.wall_top});
+        for_each_index(Policy{}, grid_.field_size(), velocity_ghosts(view(), {u[0], u[1], u[2]}));
+    }
+    detail::fill_velocity_ghosts<Real> velocity_ghosts(const fluid_view<Real>& f, std::array<Real*, 3> u) const
+    {
+        return {grid_, {u[0], u[1], u[2]}, f.wall_bottom, f.wall_top, f.inflow_bottom, f.inflow_top,
+                f.u_bottom, f.u_top, f.phi};
     }
     void fill_velocity_ghosts()
     {
