@@ -515,33 +515,35 @@ struct pcg_after_restart {
 /// pressure-Poisson problem of poisson.cuh (docs/fluid.md, *Multigrid-preconditioned CG*).
 ///
 /// **Hierarchy.** Level 0 holds the unknowns (the cells of every layer but the Dirichlet
-/// ones). A level is coarsened along x or y when its count there is even and at least 4, along
-/// z when its count of layers is even and at least 4; the cell widths along a coarsened axis
-/// double, and a Dirichlet end's distance from the first layer's centre grows by half the fine
-/// width (the coarse centre is the mean of two fine ones). Coarsening stops when no axis can be
-/// halved (on grids of powers of two, at 2 cells per axis). The operators are rediscretised on
-/// every level (mg_shape); interpolation is the tensor product of the cell-centred linear
-/// weights 3/4, 1/4 (mg_axis), restriction its transpose over 2^(coarsened axes).
+/// ones). A level is coarsened along x or y when its count there is even and at least 4
+/// (halved), along z when its count of layers is even and at least 4 (halved) or odd and at
+/// least 3 (every second layer kept: the layers between Dirichlet ends are usually odd in
+/// number); the cell widths along a coarsened axis double, and a Dirichlet end's distance from
+/// the end layer's centre grows by half a fine width (halving) or a whole one (every second
+/// layer). Coarsening stops when no axis can be coarsened (on grids of powers of two at 2 cells
+/// per axis). The operators are rediscretised on every level (mg_shape); interpolation is the
+/// tensor product of one-dimensional weights (mg_axis), restriction its transpose over
+/// 2^(coarsened axes).
 ///
 /// **V-cycle** (one per CG iteration, applied to the residual r from z = 0): on each level
 /// two damped-Jacobi sweeps (omega = 6/7, the 7-point stencil's best smoothing factor), the
 /// residual restricted to the next level, the next level's cycle, its interpolation added, two
 /// more sweeps; the coarsest level takes 2 max(n)^2 sweeps (even, 8 to 4096). The cycle is
 /// symmetric (equal sweeps before and after, restriction the scaled transpose of
-/// interpolation) and positive definite for -A, so CG stays CG: alpha = r.z / p.Ap,
+/// interpolation) and definite like A (negative), so CG stays CG: alpha = r.z / p.Ap,
 /// beta = r.z (new) / r.z (old), p = z + beta p. The singular case projects the constant out of
 /// r as cg_poisson does; z's constant part only shifts eps, whose mean is removed at the end.
 ///
 /// **Criteria, restarts, breakdown, counting**: those of cg_poisson (one iteration = one
-/// application of A and one V-cycle). The iteration count does not grow with the grid where
-/// the grid coarsens well: 7-9 iterations to a relative residual of 1e-8 at 32^3, 64^3 and
-/// 128^3 (tests/test_poisson.cpp, bench/bench_fluid.cpp). An axis whose count is odd (or whose
-/// layers are, after the Dirichlet ones are taken out) is never coarsened, and the coarsest
-/// level then takes more sweeps: on such grids cg_poisson may be as fast.
+/// application of A and one V-cycle). The iteration count does not grow with the grid: 9-10
+/// iterations to a relative residual of 1e-8 at 32^3, 64^3 and 128^3 with every pair of z
+/// boundaries (tests/test_poisson.cpp, bench/bench_fluid.cpp). An x or y count that is odd is
+/// never coarsened, and the coarsest level then keeps those cells and takes more sweeps: on
+/// such grids cg_poisson may be as fast.
 ///
-/// Owns four scratch fields (r, p, A p, z) and three arrays per level (two iterates and the
-/// right-hand side), allocated at construction; the levels are laid out for the boundaries of
-/// the first solve and again whenever a solve's boundaries differ.
+/// Owns four scratch fields (r, p, A p, z), allocated at construction, and three arrays per
+/// level (two iterates and the right-hand side), laid out by the first solve and again when a
+/// solve's boundaries differ from the last one's.
 template <class Real, class Policy>
 class mg_poisson : public detail::poisson_solver_base<mg_poisson<Real, Policy>, Real, Policy> {
     using base = detail::poisson_solver_base<mg_poisson<Real, Policy>, Real, Policy>;
