@@ -80,9 +80,8 @@ struct bond_springs {
         s.k_t = p.k_t * s.area;
         s.k_b = p.k_n * s.inertia;
         s.k_w = p.k_t * s.polar;
-        const Real m = m_i * m_j / (m_i + m_j);
-        const Real moment = Real(0.4) * m_i * r_i * r_i * (Real(0.4) * m_j * r_j * r_j) /
-                            (Real(0.4) * m_i * r_i * r_i + Real(0.4) * m_j * r_j * r_j);
+        const Real m = effective_mass(m_i, m_j);
+        const Real moment = effective_moment(r_i, r_j, m_i, m_j);
         const Real z2 = 2 * p.damping;
         s.c_n = z2 * std::sqrt(s.k_n * m);
         s.c_t = z2 * std::sqrt(s.k_t * m);
@@ -98,9 +97,8 @@ struct bond_springs {
     static Real time_scale(const bond_params<Real>& p, Real r_i, Real r_j, Real m_i, Real m_j)
     {
         const bond_springs s = make(p, r_i, r_j, m_i, m_j);
-        const Real m = m_i * m_j / (m_i + m_j);
-        const Real a = Real(0.4) * m_i * r_i * r_i, b = Real(0.4) * m_j * r_j * r_j;
-        const Real moment = a * b / (a + b);
+        const Real m = effective_mass(m_i, m_j);
+        const Real moment = effective_moment(r_i, r_j, m_i, m_j);
         const Real r = r_i > r_j ? r_i : r_j;
         const Real inf = std::numeric_limits<Real>::infinity();
         const auto scale = [&](Real inertia, Real k) { return k > 0 ? std::sqrt(inertia / k) : inf; };
@@ -108,6 +106,16 @@ struct bond_springs {
         const Real others[4] = {scale(m, s.k_t), scale(moment, s.k_b), scale(moment, s.k_w), scale(moment, s.k_t * r * r)};
         for (Real o : others) t = o < t ? o : t;
         return t * (std::sqrt(1 + p.damping * p.damping) - p.damping);
+    }
+
+    /// m* = m_i m_j / (m_i + m_j) (kg).
+    SPHERE_HDI static Real effective_mass(Real m_i, Real m_j) { return m_i * m_j / (m_i + m_j); }
+
+    /// I* = I_i I_j / (I_i + I_j) with I = 2/5 m r^2 (kg m^2).
+    SPHERE_HDI static Real effective_moment(Real r_i, Real r_j, Real m_i, Real m_j)
+    {
+        const Real a = Real(0.4) * m_i * r_i * r_i, b = Real(0.4) * m_j * r_j * r_j;
+        return a * b / (a + b);
     }
 };
 
