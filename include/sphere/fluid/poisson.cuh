@@ -14,7 +14,17 @@
 ///   + (e[i,j,k+1] - 2 e[i,j,k] + e[i,j,k-1]) / dz^2  =  b[i,j,k]
 ///
 /// with dx, dy, dz the cell widths (m) and b the right-hand side field (same layout; for the
-/// projection step eps is a pressure in Pa and b is in Pa/m^2). Boundaries:
+/// projection step eps is a pressure in Pa and b is in Pa/m^2).
+///
+/// **Variable coefficients** (`poisson_coefficients`, the Darcy model's implicit pressure
+/// diffusion, docs/fluid.md (D-4)): given a cell field K > 0 (with ghosts) and a cell field
+/// S >= 0, the row of cell c is instead
+///
+///     sum over a of [K_a+ (e[c + a] - e[c]) - K_a- (e[c] - e[c - a])] / h_a^2  -  S[c] e[c]  =  b[c]
+///
+/// with K_a+- the harmonic mean of K on the two cells of the face, 2 K K' / (K + K'): the
+/// conductance of two half cells in series. S > 0 makes the problem non-singular with any
+/// boundaries. Without coefficients K = 1 and S = 0 (the Laplacian above). Boundaries:
 ///   - x and y are always periodic (as in the seeds, whatever the world box's axis types):
 ///     neighbour -1 is cell n - 1 and neighbour n is cell 0;
 ///   - each end of z is a `z_boundary`:
@@ -120,6 +130,17 @@ struct poisson_result {
     bool converged = false;  ///< residual <= tolerance
 };
 
+/// Optional variable coefficients of a Poisson problem (poisson.cuh's file comment), in the
+/// policy's memory: K with its ghosts filled, S on the cells. The bounds K_max >= max K and
+/// S_max >= max S bound the operator's spectrum (CG's breakdown test).
+template <class Real>
+struct poisson_coefficients {
+    const Real* conductance = nullptr; ///< K (same units as the caller's equation), or null: 1
+    const Real* sink = nullptr;        ///< S (1/m^2 x K's unit), or null: 0
+    double conductance_max = 1;
+    double sink_max = 0;
+};
+
 namespace detail {
 
 /// Geometry of a Poisson problem for the kernels: the grid, the unknown cell layers
@@ -134,6 +155,12 @@ struct poisson_stencil {
     bool top_dirichlet;
     std::size_t sy, sz;         ///< field strides along y and z (x: 1)
     double cx, cy, cz;          ///< 1/dx^2, 1/dy^2, 1/dz^2 (1/m^2)
+    const Real* conductance;    ///< K (cells and ghosts), or null: K = 1 (file comment)
+    const Real* sink;           ///< S (cells), or null: S = 0
+    double lambda_max;          ///< a bound on the largest |eigenvalue| of the operator
+
+    /// Whether the operator has variable coefficients.
+    SPHERE_HD bool variable() const { return conductance != nullptr || sink != nullptr; }
 
     /// Number of unknown cells.
     SPHERE_HD std::size_t unknowns() const { return std::size_t(grid.n[0]) * grid.n[1] * std::size_t(k_count); }
@@ -157,13 +184,36 @@ struct poisson_stencil {
         return grid.field_index(i, j, k);
     }
 
+    /// The conductance of the face between field indices f and g: the harmonic mean of K.
+    SPHERE_HD double face(std::size_t f, std::size_t g) const
+    {
+        if (!conductance) return 1.0;
+        const double a = double(conductance[f]), b = double(conductance[g]);
+        return 2 * a * b / (a + b);
+    }
+
     /// (A e) at field index f, in double, from a field whose ghosts are filled.
     SPHERE_HD double laplacian(const Real* e, std::size_t f) const
     {
+        if (variable()) return variable_laplacian(e, f);
         const double c = double(e[f]);
         return cx * ((double(e[f - 1]) - c) + (double(e[f + 1]) - c)) +
                cy * ((double(e[f - sy]) - c) + (double(e[f + sy]) - c)) +
                cz * ((double(e[f - sz]) - c) + (double(e[f + sz]) - c));
+    }
+
+    /// (A e) at field index f with the coefficients (file comment), in double.
+    SPHERE_HD double variable_laplacian(const Real* e, std::size_t f) const
+    {
+        const double c = double(e[f]);
+        const std::size_t stride[3] = {1, sy, sz};
+        const double weight[3] = {cx, cy, cz};
+        double sum = sink ? -double(sink[f]) * c : 0.0;
+        for (int a = 0; a < 3; ++a) {
+            const std::size_t lo = f - stride[a], hi = f + stride[a];
+            sum += weight[a] * (face(f, hi) * (double(e[hi]) - c) - face(lo, f) * (c - double(e[lo])));
+        }
+        return sum;
     }
 };
 
@@ -274,8 +324,8 @@ struct poisson_rhs_squared {
     {
         double v = shift->from(double(b[f]));
         const int k = static_cast<int>(f / s.sz) - 1;
-        if (s.bottom_dirichlet && k == s.k_first) v -= s.cz * double(e[f - s.sz]);
-        if (s.top_dirichlet && k == s.k_first + s.k_count - 1) v -= s.cz * double(e[f + s.sz]);
+        if (s.bottom_dirichlet && k == s.k_first) v -= s.cz * s.face(f - s.sz, f) * double(e[f - s.sz]);
+        if (s.top_dirichlet && k == s.k_first + s.k_count - 1) v -= s.cz * s.face(f, f + s.sz) * double(e[f + s.sz]);
         return v * v;
     }
 };
@@ -386,6 +436,32 @@ struct jacobi_sweep {
     {
         out[f] = wx * (old[f - 1] + old[f + 1]) + wy * (old[f - s.sy] + old[f + s.sy]) +
                  wz * (old[f - s.sz] + old[f + s.sz]) - wb * (b[f] - Real(shift->hi + shift->lo));
+    }
+};
+
+/// jacobi_sweep with the coefficients (file comment): each unknown satisfies its own row with
+/// the neighbours' previous values,
+///   e_new = [sum_a c_a (K_a+ e_a+ + K_a- e_a-) - b] / [sum_a c_a (K_a+ + K_a-) + S].
+template <class Real>
+struct jacobi_sweep_variable {
+    poisson_stencil<Real> s;
+    const poisson_shift* shift; ///< policy memory
+    const Real* b;
+    const Real* old;
+    Real* out;
+
+    SPHERE_HD void operator()(std::size_t f) const
+    {
+        const std::size_t stride[3] = {1, s.sy, s.sz};
+        const double weight[3] = {s.cx, s.cy, s.cz};
+        double sum = -shift->from(double(b[f])), diagonal = s.sink ? double(s.sink[f]) : 0.0;
+        for (int a = 0; a < 3; ++a) {
+            const std::size_t lo = f - stride[a], hi = f + stride[a];
+            const double k_hi = weight[a] * s.face(f, hi), k_lo = weight[a] * s.face(lo, f);
+            sum += k_hi * double(old[hi]) + k_lo * double(old[lo]);
+            diagonal += k_hi + k_lo;
+        }
+        out[f] = Real(sum / diagonal);
     }
 };
 
@@ -699,7 +775,7 @@ public:
     const fluid_grid<Real>& grid() const { return grid_; }
 
     /// Checks the settings and the boundaries against the grid (throws), and sets the stencil.
-    void prepare(const poisson_boundaries& bc, const poisson_settings& st)
+    void prepare(const poisson_boundaries& bc, const poisson_settings& st, const poisson_coefficients<Real>& k)
     {
         if (!(st.tolerance > 0) || !std::isfinite(st.tolerance))
             fail("Poisson solver: tolerance = ", st.tolerance, " must be positive and finite");
@@ -719,15 +795,19 @@ public:
         s_.cx = 1.0 / (dx * dx);
         s_.cy = 1.0 / (dy * dy);
         s_.cz = 1.0 / (dz * dz);
+        s_.conductance = k.conductance;
+        s_.sink = k.sink;
+        s_.lambda_max = 4 * (s_.cx + s_.cy + s_.cz) * (k.conductance ? k.conductance_max : 1.0) +
+                        (k.sink ? k.sink_max : 0.0);
         all_ = s_;
         all_.k_first = 0;
         all_.k_count = static_cast<int>(grid_.n[2]);
-        singular_ = !bottom && !top;
+        singular_ = !bottom && !top && !k.sink;
         relative_ = st.criterion == poisson_criterion::relative_residual;
     }
 
     const poisson_stencil<Real>& stencil() const { return s_; }
-    /// Neumann at both ends: A annihilates the constants, and every cell is an unknown.
+    /// Neumann at both ends and no sink: A annihilates the constants, and every cell is an unknown.
     bool singular() const { return singular_; }
     bool relative() const { return relative_; }
 
@@ -883,11 +963,13 @@ public:
     /// Solves A eps = rhs (jacobi_poisson's comment): launch, read the control back, resume
     /// until it finished. eps and rhs point to fields of grid().field_size() entries in the
     /// Policy's memory space; eps holds the initial guess and the Dirichlet values on entry
-    /// and the solution, with every ghost filled, on return. Throws on bad settings, nz < 3
-    /// with a Dirichlet end, or a residual that becomes NaN or infinite.
-    poisson_result solve(Real* eps, const Real* rhs, const poisson_boundaries& bc, const poisson_settings& st)
+    /// and the solution, with every ghost filled, on return; `k` the optional variable
+    /// coefficients (file comment). Throws on bad settings, nz < 3 with a Dirichlet end, or a
+    /// residual that becomes NaN or infinite.
+    poisson_result solve(Real* eps, const Real* rhs, const poisson_boundaries& bc, const poisson_settings& st,
+                         const poisson_coefficients<Real>& k = {})
     {
-        launch(context_, control_.data(), nullptr, eps, rhs, bc, st);
+        launch(context_, control_.data(), nullptr, eps, rhs, bc, st, k);
         poisson_control c{};
         context_.read_back(&c, control_.data(), 1, "the Poisson solve's control", 0);
         while (!c.finished) {
@@ -901,9 +983,9 @@ public:
     /// control `c` (policy memory); nothing runs if *hold (hold may be null). Throws on bad
     /// settings. When c->finished is 0 after the launch, resume() launches more passes.
     void launch(execution_context<Policy>& ctx, poisson_control* c, const int* hold, Real* eps, const Real* rhs,
-                const poisson_boundaries& bc, const poisson_settings& st)
+                const poisson_boundaries& bc, const poisson_settings& st, const poisson_coefficients<Real>& k = {})
     {
-        problem_.prepare(bc, st);
+        problem_.prepare(bc, st, k);
         ctx_ = &ctx;
         c_ = c;
         eps_ = eps;
@@ -1057,10 +1139,14 @@ private:
         } else {
             for_each_index(Policy{}, 1, detail::jacobi_begin_pass{c});
         }
-        const double D = 2 * (s.cx + s.cy + s.cz);
-        const detail::jacobi_sweep<Real> k{s, Real(s.cx / D), Real(s.cy / D), Real(s.cz / D), Real(1 / D), &c->shift,
-                                           rhs_, from, to};
-        problem_.for_each_unknown(&c->iterate, k);
+        if (s.variable()) {
+            problem_.for_each_unknown(&c->iterate, detail::jacobi_sweep_variable<Real>{s, &c->shift, rhs_, from, to});
+        } else {
+            const double D = 2 * (s.cx + s.cy + s.cz);
+            const detail::jacobi_sweep<Real> k{s, Real(s.cx / D), Real(s.cy / D), Real(s.cz / D), Real(1 / D),
+                                               &c->shift, rhs_, from, to};
+            problem_.for_each_unknown(&c->iterate, k);
+        }
         problem_.fill_ghosts(to, &c->iterate);
         if (!problem_.relative()) problem_.normalized_change_into(*ctx_, &c->iterate, to, from, nullptr, nullptr, &c->change);
         for_each_index(Policy{}, 1, detail::jacobi_after_sweep{c});

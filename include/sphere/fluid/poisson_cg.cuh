@@ -50,6 +50,25 @@ struct poisson_apply {
     }
 };
 
+/// q = A p at cell f with the variable coefficients (poisson.cuh), computed in double.
+template <class Real>
+struct poisson_apply_variable {
+    poisson_stencil<Real> s;
+    const Real* p;
+    Real* q;
+    SPHERE_HD void operator()(std::size_t f) const { q[f] = Real(s.variable_laplacian(p, f)); }
+};
+
+/// q = A p on the unknowns if *go: the constant-coefficient kernel, or the variable one.
+template <class Problem, class Real>
+void apply_operator(const Problem& problem, const int* go, const poisson_stencil<Real>& s, const Real* p, Real* q)
+{
+    if (s.variable())
+        problem.for_each_unknown(go, poisson_apply_variable<Real>{s, p, q});
+    else
+        problem.for_each_unknown(go, poisson_apply<Real>{s, Real(s.cx), Real(s.cy), Real(s.cz), p, q});
+}
+
 /// a . b over the unknowns (each product in double).
 template <class Real>
 struct poisson_dot {
@@ -319,13 +338,12 @@ private:
         // |alpha| <= 1 / (smallest non-zero |eigenvalue|) for a direction in the range of A,
         // so |alpha| lambda_max is at most the condition number; a step beyond 1 / epsilon is
         // a direction that A does not see (round-off), never a useful step.
-        const double lambda_max = 4 * (s.cx + s.cy + s.cz);
-        const double largest_step = 1 / (lambda_max * 2.220446049250313e-16);
+        const double largest_step = 1 / (s.lambda_max * 2.220446049250313e-16);
         const double cells = double(problem_.grid().cell_count());
 
         for_each_index(Policy{}, 1, detail::cg_begin_pass{c});
         problem_.fill_ghosts(p, &c->iterate);
-        problem_.for_each_unknown(&c->iterate, detail::poisson_apply<Real>{s, Real(s.cx), Real(s.cy), Real(s.cz), p, q});
+        detail::apply_operator(problem_, &c->iterate, s, p, q);
         problem_.sum_unknowns_into(ctx, &c->iterate, detail::poisson_dot<Real>{p, q}, &c->sum);
         for_each_index(Policy{}, 1, detail::cg_after_apply{c, largest_step});
 

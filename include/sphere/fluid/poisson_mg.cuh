@@ -704,13 +704,12 @@ private:
         Real* r = r_.data();
         Real* p = p_.data();
         Real* q = q_.data();
-        const double lambda_max = 4 * (s.cx + s.cy + s.cz);
-        const double largest_step = 1 / (lambda_max * 2.220446049250313e-16);
+        const double largest_step = 1 / (s.lambda_max * 2.220446049250313e-16);
         const double cells = double(problem_.grid().cell_count());
 
         for_each_index(Policy{}, 1, detail::cg_begin_pass{c});
         problem_.fill_ghosts(p, &c->iterate);
-        problem_.for_each_unknown(&c->iterate, detail::poisson_apply<Real>{s, Real(s.cx), Real(s.cy), Real(s.cz), p, q});
+        detail::apply_operator(problem_, &c->iterate, s, p, q);
         problem_.sum_unknowns_into(ctx, &c->iterate, detail::poisson_dot<Real>{p, q}, &c->sum);
         for_each_index(Policy{}, 1, detail::pcg_after_apply{c, largest_step});
 
