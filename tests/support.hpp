@@ -119,4 +119,23 @@ std::size_t run_until_separated(Sim& sim, std::size_t max_steps)
     return k;
 }
 
+/// F8's bed: fixed spheres of diameter d on a simple cubic lattice of spacing d, 8 x 8 x
+/// (2 nz - 1), at (i + offset, j + offset, k + offset) d.
+template <class Real>
+std::vector<sphere::particle<Real>> fixed_lattice_bed(int nz, double d, double offset)
+{
+    std::vector<sphere::particle<Real>> bed;
+    for (int k = 0; k < 2 * nz - 1; ++k)
+        for (int j = 0; j < 8; ++j)
+            for (int i = 0; i < 8; ++i) {
+                sphere::particle<Real> p;
+                p.position = {Real((i + offset) * d), Real((j + offset) * d), Real((k + offset) * d)};
+                p.radius = Real(d / 2);
+                p.density = 2600;
+                p.kind = sphere::motion::fixed;
+                bed.push_back(p);
+            }
+    return bed;
+}
+
 } // namespace sphere_test

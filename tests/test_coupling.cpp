@@ -18,6 +18,8 @@
 #include <sphere/dem.cuh>
 #include <sphere/fluid.cuh>
 
+#include "support.hpp"
+
 #include <omp.h>
 
 #include <cmath>
@@ -45,25 +47,6 @@ sphere::settings<Real> periodic_column(double lx, double ly, double lz, double k
     s.box.axis[0] = s.box.axis[1] = sphere::boundary::periodic;
     s.contact.k_n = s.wall.k_n = s.contact.k_t = s.wall.k_t = Real(k_n);
     return s;
-}
-
-/// F8's bed: fixed spheres of diameter d on a simple cubic lattice of spacing d, 8 x 8 x
-/// (2 nz - 1), at (i + offset, j + offset, k + offset) d.
-template <class Real>
-std::vector<sphere::particle<Real>> fixed_lattice_bed(int nz, double d, double offset)
-{
-    std::vector<sphere::particle<Real>> bed;
-    for (int k = 0; k < 2 * nz - 1; ++k)
-        for (int j = 0; j < 8; ++j)
-            for (int i = 0; i < 8; ++i) {
-                sphere::particle<Real> p;
-                p.position = {Real((i + offset) * d), Real((j + offset) * d), Real((k + offset) * d)};
-                p.radius = Real(d / 2);
-                p.density = 2600;
-                p.kind = sphere::motion::fixed;
-                bed.push_back(p);
-            }
-    return bed;
 }
 
 } // namespace
@@ -149,7 +132,7 @@ TEMPLATE_TEST_CASE("F8: the pressure drop through a fixed bed follows Ergun for 
     const int nz = 12;
     sphere::settings<Real> s = periodic_column<Real>(4 * cell, 4 * cell, nz * cell, 1e-4);
     s.dt = Real(5e-4);
-    const std::vector<sphere::particle<Real>> bed = fixed_lattice_bed<Real>(nz, d, offset);
+    const std::vector<sphere::particle<Real>> bed = sphere_test::fixed_lattice_bed<Real>(nz, d, offset);
     for (bool pressure_force : {true, false}) {
         CAPTURE(pressure_force);
         sim_t<Real> sim(s, bed);
@@ -211,7 +194,7 @@ TEMPLATE_TEST_CASE("inflow through a fixed bed: the prescribed superficial veloc
     const int nz = 12;
     sphere::settings<Real> s = periodic_column<Real>(4 * cell, 4 * cell, nz * cell, 1e-4);
     s.dt = Real(5e-4);
-    sim_t<Real> sim(s, fixed_lattice_bed<Real>(nz, d, 0.5));
+    sim_t<Real> sim(s, sphere_test::fixed_lattice_bed<Real>(nz, d, 0.5));
     sphere::fluid_params<Real> prm;
     prm.density = Real(rho);
     prm.viscosity = Real(mu);

@@ -2,8 +2,9 @@
 /// \file
 /// The fluid half of sphere: `#include <sphere/fluid.cuh>` brings in the fluid grid, the lens
 /// volume, the porosity estimator, the drag laws, the Poisson solvers, the Navier-Stokes
-/// solver and its coupling to the particles (docs/fluid.md).
+/// solver, the Darcy model and their coupling to the particles (docs/fluid.md).
 #include "fluid/coupling.cuh"
+#include "fluid/darcy.cuh"
 #include "fluid/drag.cuh"
 #include "fluid/fluid_params.cuh"
 #include "fluid/grid.cuh"
@@ -13,3 +14,4 @@
 #include "fluid/poisson_cg.cuh"
 #include "fluid/poisson_mg.cuh"
 #include "fluid/porosity.cuh"
+#include "fluid/snapshot.cuh"

@@ -22,6 +22,7 @@
 /// whose check of its next drift, which the new forces change, comes back with that report).
 /// The forces are explicit: dt_f must not exceed the shortest particle response time
 /// m_i / (beta_per_solid V_i) (checked; the step throws naming the particle).
+#include <cmath>
 #include <cstddef>
 #include <type_traits>
 
@@ -37,6 +38,7 @@
 #include "drag.cuh"
 #include "navier_stokes.cuh"
 #include "porosity.cuh"
+#include "snapshot.cuh"
 
 namespace sphere {
 
@@ -51,64 +53,11 @@ struct coupling_options {
 
 namespace detail {
 
-/// The fluid force on particle i (N), and its response time m / (drag coefficient) (s). A
-/// kernel of its own, whose response times a plain reduction then takes the least of: inlined
-/// into a CUB reduction (which unrolls several items per thread) the drag laws spill
-/// registers (tests/check_ptxas.py).
-template <class Real, class Drag>
-struct fluid_particle_force {
-    fluid_view<Real> f;
-    porosity_view<Real> por;
-    particle_view<Real> p;
-    vec3<Real>* out;
-    Real* response;
-    bool pressure_force;
-
-    SPHERE_HD void operator()(std::size_t i) const
-    {
-        const vec4<Real> x = p.x[i];
-        int cell[3];
-        f.grid.cell_of(x.xyz(), cell);
-        const long long c = f.at(cell[0], cell[1], cell[2]);
-        const Real r = x.w;
-        const Real V = Real(4) / Real(3) * pi<Real> * r * r * r;
-        const bool has_solid = por.d_p[c] > Real(0);
-        const Real d = has_solid ? por.d_p[c] : Real(2) * r;
-        const vec3<Real> v_p = has_solid ? por.v_p[c] : p.v_sync[i];
-        const vec3<Real> rel = f.cell_velocity(c) - v_p;
-        const Real phi = f.phi[c];
-        const Real k = Drag::beta_per_solid(phi, d, norm(rel), f.rho, f.mu) * V;
-        vec3<Real> force = rel * k;
-        if (pressure_force) force += drag::pressure_gradient_force(V, f.pressure_gradient(c));
-        out[i] = force;
-        response[i] = k > Real(0) ? p.mass[i] / k : Real(1e30);
-    }
-};
-
 /// values[i] (a reduction's transform over an array).
 template <class T>
 struct value_at {
     const T* values;
     SPHERE_HDI T operator()(std::size_t i) const { return values[i]; }
-};
-
-/// The force density on the fluid in each cell (N/m^3): minus the sum of the forces on the
-/// particles whose centres lie in it, over the cell volume, in bin order.
-template <class Real>
-struct fluid_reaction {
-    fluid_view<Real> f;
-    grid_view<Real> bins;
-    const vec3<Real>* particle_force;
-
-    SPHERE_HD void operator()(std::size_t cell) const
-    {
-        int k;
-        const long long c = f.cell_field(cell, k);
-        vec3<Real> sum{0, 0, 0};
-        for (unsigned s = bins.cell_start[cell]; s < bins.cell_start[cell + 1]; ++s) sum += particle_force[bins.order[s]];
-        const Real volume = f.grid.width.x * f.grid.width.y * f.grid.width.z;
-        f.force[c] = sum * (Real(-1) / volume);
-    }
 };
 
 /// Copies the position of the particle in slot k to its user index.
@@ -147,18 +96,24 @@ struct add_work {
 } // namespace detail
 
 /// The pore fluid coupled to a simulation's particles. `Drag` is a drag law of sphere::drag,
-/// `Poisson` the pressure solver.
-template <class Real, class Policy, class Drag = drag::gidaspow, class Poisson = mg_poisson<Real, Policy>>
+/// `Poisson` the pressure solver, `Model` the fluid model: navier_stokes (default; `params` a
+/// fluid_params) or darcy_flow (`params` a darcy_params; the drag law is not used: the Darcy
+/// model's force on the particles is its pressure gradient's, docs/fluid.md, *Darcy model*).
+template <class Real, class Policy, class Drag = drag::gidaspow, class Poisson = mg_poisson<Real, Policy>,
+          template <class, class, class> class Model = navier_stokes>
 class fluid_coupling {
 public:
-    fluid_coupling(const fluid_grid<Real>& g, const fluid_params<Real>& params, const coupling_options& options = {})
+    using model_type = Model<Real, Policy, Poisson>;
+
+    template <class Params>
+    fluid_coupling(const fluid_grid<Real>& g, const Params& params, const coupling_options& options = {})
         : options_(options), porosity_(g, options.porosity), fluid_(g, params)
     {
         if (options.dem_steps < 1) detail::fail("coupling: dem_steps = 0; at least one DEM step per fluid step");
         Drag::validate();
     }
 
-    navier_stokes<Real, Policy, Poisson>& fluid() { return fluid_; }
+    model_type& fluid() { return fluid_; }
     const porosity_estimator<Real, Policy>& porosity() const { return porosity_; }
     const coupling_options& options() const { return options_; }
 
@@ -178,14 +133,11 @@ public:
         fluid_.set_porosity(porosity_.view());
         vec3<Real>* forces = sim.external_forces();
         if (response_.size() != p.n) response_ = buffer<Real, Policy>(p.n);
-        for_each_index(Policy{}, p.n,
-                       detail::fluid_particle_force<Real, Drag>{fluid_.view(), porosity_.view(), p, forces,
-                                                                response_.data(), options_.pressure_force});
+        fluid_.template particle_forces<Drag>(p, porosity_.view(), forces, response_.data(), options_.pressure_force);
         detail::fluid_report<Real>* report = fluid_.report();
         transform_reduce_into(fluid_.context(), p.n, detail::value_at<Real>{response_.data()}, Real(1e30), min_op{},
                               &report->response);
-        for_each_index(Policy{}, fluid_.grid().cell_count(),
-                       detail::fluid_reaction<Real>{fluid_.view(), porosity_.bins(), forces});
+        fluid_.take_reaction(porosity_.bins(), forces);
         // New forces change where a drift-first integrator's next drift goes: its check comes
         // back with the fluid's report instead of with a read-back of its own.
         const bool predicted = sim.predict_drift_into(&report->next_drift);
@@ -218,10 +170,55 @@ public:
         return r.work_total;
     }
 
+    /// A host copy of the coupling's evolving state (fluid/snapshot.cuh; docs/fluid.md,
+    /// *Restarting a coupled run*), for write_checkpoint(path, sim, coupling): the fluid
+    /// model's snapshot (its entries under their own names, its model name the snapshot's),
+    /// the porosity estimator's under "porosity.", and work_on_particles() as the number
+    /// "coupling.work_total". Nothing else carries over from one coupled step to the next:
+    /// the particle forces, response times and start positions are written by each step before
+    /// they are read.
+    fluid_snapshot<Real> snapshot()
+    {
+        fluid_snapshot<Real> s = fluid_.snapshot();
+        s.merge("porosity.", porosity_.snapshot());
+        s.add_number("coupling.work_total", work_on_particles());
+        return s;
+    }
+
+    /// Continues from a snapshot() of a coupling on the same grid with the same fluid model
+    /// (and, the caller's to see to, the same parameters, options and drag law), next to a
+    /// simulation restored to the same step (sphere::restart(path, coupling) does both): the
+    /// next coupled steps give the bits the snapshotted coupling's gave. Throws sphere::error,
+    /// with nothing changed, for a snapshot of another grid, for the reasons of the fluid
+    /// model's and the porosity estimator's restore (another model, an entry missing or
+    /// unknown, an array of another length, another porosity method) and for a missing or
+    /// unknown "coupling." entry.
+    void restore(const fluid_snapshot<Real>& s)
+    {
+        const char* who = "fluid_coupling::restore";
+        s.check_grid(who, porosity_.grid());
+        const fluid_snapshot<Real> own = s.part("coupling.", "coupling");
+        own.check_only(who, {}, {"work_total"}, {});
+        const double work = own.number_named(who, "work_total");
+        if (!std::isfinite(work)) detail::fail(who, ": the snapshot's work_total = ", work, " J is not finite");
+        const fluid_snapshot<Real> por = s.part("porosity.", porosity_.model_name());
+        porosity_.check_snapshot(por);
+        fluid_.restore(s.other_than({"porosity.", "coupling."})); // checks everything before it changes anything
+        porosity_.restore(por);
+        for_each_index(Policy{}, 1, set_work_total{fluid_.report(), work});
+    }
+
+    /// Sets the work total in the fluid's report (restore()).
+    struct set_work_total {
+        detail::fluid_report<Real>* r;
+        double total;
+        SPHERE_HD void operator()(std::size_t) const { r->work_total = total; }
+    };
+
 private:
     coupling_options options_;
     porosity_estimator<Real, Policy> porosity_;
-    navier_stokes<Real, Policy, Poisson> fluid_;
+    model_type fluid_;
     buffer<vec4<Real>, Policy> x_before_;  ///< positions at the start of the DEM steps, by user index
     buffer<Real, Policy> response_;        ///< each particle's response time to the drag (s)
 };

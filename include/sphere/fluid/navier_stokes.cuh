@@ -14,18 +14,24 @@
 #include <cstddef>
 #include <vector>
 
+#include "../core/constants.cuh"
 #include "../core/error.cuh"
 #include "../core/vec.cuh"
 #include "../exec/algorithms.cuh"
 #include "../exec/buffer.cuh"
 #include "../exec/context.cuh"
 #include "../exec/for_each.cuh"
+#include "../grid/neighbor_grid.cuh"
+#include "../particles/state.cuh"
+#include "drag.cuh"
+#include "fields.cuh"
 #include "fluid_params.cuh"
 #include "grid.cuh"
 #include "poisson.cuh"
 #include "poisson_cg.cuh"
 #include "poisson_mg.cuh"
 #include "porosity.cuh"
+#include "snapshot.cuh"
 
 namespace sphere {
 
@@ -81,42 +87,6 @@ struct fluid_view {
 };
 
 namespace detail {
-
-/// Source cell of ghost node (i, j, k): periodic in x and y, nearest cell in z.
-template <class Real>
-SPHERE_HD void ghost_source(const fluid_grid<Real>& g, int& i, int& j, int& k)
-{
-    const int nx = int(g.n[0]), ny = int(g.n[1]), nz = int(g.n[2]);
-    i = i < 0 ? i + nx : (i >= nx ? i - nx : i);
-    j = j < 0 ? j + ny : (j >= ny ? j - ny : j);
-    k = k < 0 ? 0 : (k >= nz ? nz - 1 : k);
-}
-
-/// Fills the ghost nodes of a cell-centred field of T (Real or vec3<Real>): periodic copies in
-/// x and y; along z a copy of the nearest cell, or (extrapolate_z) the linear extrapolation
-/// 2 f(0) - f(1).
-template <class Real, class T>
-struct fill_cell_ghosts {
-    fluid_grid<Real> g;
-    T* f;
-    bool extrapolate_z;
-
-    SPHERE_HD void operator()(std::size_t node) const
-    {
-        int i, j, k;
-        g.field_coordinates(node, i, j, k);
-        if (g.is_cell(i, j, k)) return;
-        const int kz = k;
-        ghost_source(g, i, j, k);
-        const std::size_t s = g.field_index(i, j, k);
-        if (extrapolate_z && kz != k && g.n[2] > 1) {
-            const int inner = kz < 0 ? 1 : int(g.n[2]) - 2;
-            f[node] = f[s] + (f[s] - f[g.field_index(i, j, inner)]);
-        } else {
-            f[node] = f[s];
-        }
-    }
-};
 
 /// Fills the ghost faces of the three face-velocity fields and sets the z faces at the top and
 /// bottom of the grid: zero on a no-flow wall, U / phi at an inflow end (U the prescribed
@@ -348,30 +318,6 @@ struct face_momentum {
     }
 };
 
-/// Why a fluid step held (did not advance): fluid_report::hold.
-enum fluid_hold : int {
-    fluid_advances = 0,
-    fluid_hold_porosity = 1, ///< a cell's porosity is not in (0, 1]
-    fluid_hold_response = 2, ///< dt exceeds the shortest particle response time (the coupling's)
-    fluid_hold_stability = 3, ///< dt exceeds the stability limit
-};
-
-/// What a fluid step found, in the policy's memory; the step reads it back once, at its end
-/// (docs/fluid.md, *Solves without waiting*).
-template <class Real>
-struct fluid_report {
-    poisson_control solve;
-    Real lowest_porosity; ///< the smallest cell porosity set_porosity was given
-    Real response;        ///< the shortest particle response time (s) the coupling wrote (1e30 alone)
-    Real phi_min, rate;   ///< the stability limit's reductions: least porosity, largest advective rate (1/s)
-    Real limit;           ///< the stability limit (s)
-    int hold;             ///< fluid_hold
-    int commit;           ///< the solve converged and nothing held: the fields advance
-    Real next_drift;      ///< the coupling's: the simulation's check of its next drift (predict_drift_into)
-    double work_step;     ///< the coupling's: the fluid's work on the particles in the last step (J)
-    double work_total;    ///< and its sum (J)
-};
-
 /// The checks before a fluid step of length dt: the stability limit from the reductions, and
 /// why the step holds, if it does (the first failing check, in fluid_hold's order).
 template <class Real>
@@ -392,13 +338,56 @@ struct fluid_precheck {
     }
 };
 
-/// Whether the step's fields advance: the solve is over, converged, and nothing held.
-template <class Real>
-struct fluid_commit {
-    fluid_report<Real>* r;
-    SPHERE_HD void operator()(std::size_t) const
+/// The fluid force on particle i (N), and its response time m / (drag coefficient) (s). A
+/// kernel of its own, whose response times a plain reduction then takes the least of: inlined
+/// into a CUB reduction (which unrolls several items per thread) the drag laws spill
+/// registers (tests/check_ptxas.py).
+template <class Real, class Drag>
+struct fluid_particle_force {
+    fluid_view<Real> f;
+    porosity_view<Real> por;
+    particle_view<Real> p;
+    vec3<Real>* out;
+    Real* response;
+    bool pressure_force;
+
+    SPHERE_HD void operator()(std::size_t i) const
     {
-        r->commit = r->solve.finishing && r->solve.converged && r->hold == fluid_advances;
+        const vec4<Real> x = p.x[i];
+        int cell[3];
+        f.grid.cell_of(x.xyz(), cell);
+        const long long c = f.at(cell[0], cell[1], cell[2]);
+        const Real r = x.w;
+        const Real V = Real(4) / Real(3) * pi<Real> * r * r * r;
+        const bool has_solid = por.d_p[c] > Real(0);
+        const Real d = has_solid ? por.d_p[c] : Real(2) * r;
+        const vec3<Real> v_p = has_solid ? por.v_p[c] : p.v_sync[i];
+        const vec3<Real> rel = f.cell_velocity(c) - v_p;
+        const Real phi = f.phi[c];
+        const Real k = Drag::beta_per_solid(phi, d, norm(rel), f.rho, f.mu) * V;
+        vec3<Real> force = rel * k;
+        if (pressure_force) force += drag::pressure_gradient_force(V, f.pressure_gradient(c));
+        out[i] = force;
+        response[i] = k > Real(0) ? p.mass[i] / k : Real(1e30);
+    }
+};
+
+/// The force density on the fluid in each cell (N/m^3): minus the sum of the forces on the
+/// particles whose centres lie in it, over the cell volume, in bin order.
+template <class Real>
+struct fluid_reaction {
+    fluid_view<Real> f;
+    grid_view<Real> bins;
+    const vec3<Real>* particle_force;
+
+    SPHERE_HD void operator()(std::size_t cell) const
+    {
+        int k;
+        const long long c = f.cell_field(cell, k);
+        vec3<Real> sum{0, 0, 0};
+        for (unsigned s = bins.cell_start[cell]; s < bins.cell_start[cell + 1]; ++s) sum += particle_force[bins.order[s]];
+        const Real volume = f.grid.width.x * f.grid.width.y * f.grid.width.z;
+        f.force[c] = sum * (Real(-1) / volume);
     }
 };
 
@@ -425,12 +414,14 @@ struct fluid_commit {
 /// Its reductions and read-back go through the solver's own execution context; its kernels run
 /// on the default stream, which the context's (blocking) stream stays ordered with.
 template <class Real, class Policy, class Poisson = mg_poisson<Real, Policy>>
-class navier_stokes {
+class navier_stokes : public detail::fluid_model_base<Real, Policy, Poisson> {
+    using base = detail::fluid_model_base<Real, Policy, Poisson>;
+
 public:
     navier_stokes(const fluid_grid<Real>& g, const fluid_params<Real>& params)
-        : grid_(g), params_(params), p_(g.field_size(), Real(0)), eps_(g.field_size(), Real(0)),
+        : base(g), grid_(g), params_(params), p_(g.field_size(), Real(0)), eps_(g.field_size(), Real(0)),
           rhs_(g.field_size(), Real(0)), phi_(g.field_size(), Real(1)), dphi_(g.field_size(), Real(0)),
-          force_(g.field_size(), vec3<Real>{0, 0, 0}), poisson_(g), report_(1, initial_report())
+          force_(g.field_size(), vec3<Real>{0, 0, 0})
     {
         params_.validate();
         const bool pressure_end = params_.bottom.kind == fluid_boundary_kind::pressure ||
@@ -447,9 +438,6 @@ public:
 
     const fluid_grid<Real>& grid() const { return grid_; }
     const fluid_params<Real>& params() const { return params_; }
-    double time() const { return time_; }
-    /// Result of the last pressure solve (iterations, residual).
-    const poisson_result& last_solve() const { return last_solve_; }
 
     fluid_view<Real> view()
     {
@@ -590,21 +578,7 @@ public:
         bc.bottom = params_.bottom.kind == fluid_boundary_kind::pressure ? z_boundary::dirichlet : z_boundary::neumann;
         bc.top = params_.top.kind == fluid_boundary_kind::pressure ? z_boundary::dirichlet : z_boundary::neumann;
         poisson_.launch(context_, &r->solve, &r->hold, eps_.data(), rhs_.data(), bc, params_.poisson);
-        correct(dt, vs);
-        context_.read_back(&host_report_, r, 1, "the fluid step's report", steps_);
-        while (!host_report_.solve.finished) {
-            poisson_.resume(context_);
-            correct(dt, vs);
-            context_.read_back(&host_report_, r, 1, "the fluid step's report", steps_);
-        }
-        if (host_report_.hold == detail::fluid_advances) {
-            last_solve_ = poisson_.learn(host_report_.solve);
-            if (host_report_.commit) {
-                time_ += double(dt);
-                ++steps_;
-            }
-        }
-        return host_report_;
+        return this->conclude_step(dt, "the fluid step's report", [&] { correct(dt, vs); });
     }
 
     /// Throws the error of a step that did not advance (report: advance's), naming the check.
@@ -629,21 +603,84 @@ public:
                          params_.poisson.tolerance, "); raise fluid_params::poisson.max_iterations or reduce dt");
     }
 
-    /// The fluid's execution context (its reductions, scratch and read-backs).
-    execution_context<Policy>& context() { return context_; }
-    /// The step's report in the policy's memory, for a caller that adds its own checks and
-    /// sums to it (the coupling: the response time, the work).
-    detail::fluid_report<Real>* report() { return report_.data(); }
-
-private:
-    static detail::fluid_report<Real> initial_report()
+    /// The coupling's hooks (fluid_coupling::step): writes the fluid force on each particle
+    /// (detail::fluid_particle_force: the drag of its cell, and -V grad p if pressure_force) to
+    /// out and its response time to the drag to response.
+    template <class Drag>
+    void particle_forces(const particle_view<Real>& p, const porosity_view<Real>& por, vec3<Real>* out,
+                         Real* response, bool pressure_force)
     {
-        detail::fluid_report<Real> r{};
-        r.lowest_porosity = 1;
-        r.response = Real(1e30);
-        return r;
+        for_each_index(Policy{}, p.n,
+                       detail::fluid_particle_force<Real, Drag>{view(), por, p, out, response, pressure_force});
+    }
+    /// The particles' reaction on the fluid (detail::fluid_reaction), from their forces.
+    void take_reaction(const grid_view<Real>& bins, const vec3<Real>* particle_force)
+    {
+        for_each_index(Policy{}, grid_.cell_count(), detail::fluid_reaction<Real>{view(), bins, particle_force});
     }
 
+
+    /// The model's name in a fluid_snapshot.
+    static const char* model_name() { return "navier_stokes"; }
+
+    /// A host copy of the fluid's evolving state (fluid/snapshot.cuh; docs/fluid.md,
+    /// *Restarting a coupled run*), for a checkpoint: the face velocities u_x, u_y, u_z and the
+    /// pressure p (advanced by every step), the last pressure increment eps (the next solve's
+    /// initial guess: it changes the bits of the next solution), the porosity phi, its rate
+    /// dphi_dt and the interaction force (what a step on its own reads from the last
+    /// set_porosity and interaction_force; a coupled step writes them first), the time (the
+    /// prescribed pressures' p(t)) and the step count, and the last solve's result
+    /// (last_solve(); read by nothing but the caller). Every field in field layout, ghosts
+    /// included.
+    fluid_snapshot<Real> snapshot() const
+    {
+        fluid_snapshot<Real> s = fluid_snapshot<Real>::of(model_name(), grid_);
+        const char* u_names[3] = {"u_x", "u_y", "u_z"};
+        for (int a = 0; a < 3; ++a) s.add(u_names[a], u_[a].to_host());
+        s.add("p", p_.to_host());
+        s.add("eps", eps_.to_host());
+        s.add("phi", phi_.to_host());
+        s.add("dphi_dt", dphi_.to_host());
+        s.add("force", force_.to_host());
+        this->add_step_state(s);
+        return s;
+    }
+
+    /// Continues from a snapshot() of a navier_stokes on the same grid (with the same
+    /// parameters: they are the caller's, not part of the snapshot): the next step gives the
+    /// bits the snapshotted fluid's next step gave. Throws sphere::error, with nothing
+    /// changed, when the snapshot is of another model or grid, lacks an entry or holds one
+    /// this model does not have, or an array has another length than the grid's fields.
+    void restore(const fluid_snapshot<Real>& s)
+    {
+        const char* who = "navier_stokes::restore";
+        s.check_model_and_grid(who, model_name(), grid_);
+        s.check_only(who, {"u_x", "u_y", "u_z", "p", "eps", "phi", "dphi_dt", "force"}, base::step_numbers(),
+                     base::step_counts());
+        const std::size_t size = grid_.field_size();
+        const char* what = "the grid's field size, ghost nodes included";
+        const char* u_names[3] = {"u_x", "u_y", "u_z"};
+        const std::vector<Real>* u[3];
+        for (int a = 0; a < 3; ++a) u[a] = &s.array_named(who, u_names[a], size, what);
+        const std::vector<Real>& p = s.array_named(who, "p", size, what);
+        const std::vector<Real>& eps = s.array_named(who, "eps", size, what);
+        const std::vector<Real>& phi = s.array_named(who, "phi", size, what);
+        const std::vector<Real>& dphi = s.array_named(who, "dphi_dt", size, what);
+        const std::vector<vec3<Real>> force = s.vectors_named(who, "force", size, "3 per node of the grid's fields");
+        const typename base::step_state st = base::read_step_state(s, who);
+        for (int a = 0; a < 3; ++a) u_[a].assign(*u[a]);
+        p_.assign(p);
+        eps_.assign(eps);
+        phi_.assign(phi);
+        dphi_.assign(dphi);
+        force_.assign(force);
+        this->apply_step_state(st);
+        // What set_porosity found (a step on its own checks it).
+        transform_reduce_into(context_, grid_.cell_count(), detail::cell_porosity<Real>{view()}, Real(1), min_op{},
+                              &report_.data()->lowest_porosity);
+    }
+
+private:
     /// Where the step's solve finished and nothing held: the projection of the predicted
     /// velocities vs (detail::correct_velocity) and the ghosts.
     void correct(Real dt, const Real* const* vs)
@@ -708,18 +745,18 @@ private:
                                                                  params_.top.value(t), Real(0)});
     }
 
+    using base::context_;
+    using base::poisson_;
+    using base::report_;
+    using base::steps_;
+    using base::time_;
+    using base::last_solve_;
+
     fluid_grid<Real> grid_;
     fluid_params<Real> params_;
     buffer<Real, Policy> u_[3], us_[3];
     buffer<Real, Policy> p_, eps_, rhs_, phi_, dphi_;
     buffer<vec3<Real>, Policy> force_;
-    Poisson poisson_;
-    execution_context<Policy> context_;
-    buffer<detail::fluid_report<Real>, Policy> report_;
-    detail::fluid_report<Real> host_report_{};
-    poisson_result last_solve_{};
-    double time_ = 0;
-    std::size_t steps_ = 0; ///< steps taken (names a failed read-back)
 };
 
 } // namespace sphere

@@ -18,6 +18,7 @@
 #include "../particles/state.cuh"
 #include "grid.cuh"
 #include "lens.cuh"
+#include "snapshot.cuh"
 
 namespace sphere {
 
@@ -344,6 +345,61 @@ public:
     porosity_fields<Real> fields() const
     {
         return {grid_, phi_.to_host(), dphi_dt_.to_host(), d_p_.to_host(), v_p_.to_host()};
+    }
+
+    /// The estimator's name in a fluid_snapshot.
+    static const char* model_name() { return "porosity"; }
+
+    /// A host copy of the estimator's state (fluid/snapshot.cuh; docs/fluid.md, *Restarting a
+    /// coupled run*), for a checkpoint: the porosity phi, which the next update reads as the
+    /// previous one (dphi/dt = (phi - previous) / dt), and have_previous (0: the next update
+    /// sets dphi/dt = 0); dphi_dt, d_p and v_p (3 per node) too, which the next update
+    /// overwrites, so that fields() reads the same after a restore. The porosity method, to
+    /// be checked. Field layout, ghost nodes included.
+    fluid_snapshot<Real> snapshot() const
+    {
+        fluid_snapshot<Real> s = fluid_snapshot<Real>::of(model_name(), grid_);
+        s.add("phi", phi_.to_host());
+        s.add("dphi_dt", dphi_dt_.to_host());
+        s.add("d_p", d_p_.to_host());
+        s.add("v_p", v_p_.to_host());
+        s.add_count("have_previous", have_previous_ ? 1 : 0);
+        s.add_count("method", method_ == porosity_method::cell_volume ? 0 : 1);
+        return s;
+    }
+
+    /// Throws what restore() would throw for snapshot s, changing nothing.
+    void check_snapshot(const fluid_snapshot<Real>& s) const
+    {
+        const char* who = "porosity_estimator::restore";
+        s.check_model_and_grid(who, model_name(), grid_);
+        s.check_only(who, {"phi", "dphi_dt", "d_p", "v_p"}, {}, {"have_previous", "method"});
+        const std::size_t size = grid_.field_size();
+        const char* what = "the grid's field size, ghost nodes included";
+        for (const char* name : {"phi", "dphi_dt", "d_p"}) s.array_named(who, name, size, what);
+        s.array_named(who, "v_p", 3 * size, "3 per node of the grid's fields");
+        s.count_named(who, "have_previous", 1);
+        const bool sphere = s.count_named(who, "method", 1) == 1;
+        if (sphere != (method_ == porosity_method::cell_sphere))
+            detail::fail(who, ": the snapshot's porosity method is ", sphere ? "cell_sphere" : "cell_volume",
+                         ", this estimator's ", sphere ? "cell_volume" : "cell_sphere");
+    }
+
+    /// Continues from a snapshot() of an estimator of the same grid and method: the next update
+    /// gives the bits the snapshotted estimator's next update gave. Throws sphere::error, with
+    /// nothing changed, when the snapshot is of another grid or method, lacks an entry or holds
+    /// one the estimator does not have, or an array has another length than the grid's fields.
+    void restore(const fluid_snapshot<Real>& s)
+    {
+        check_snapshot(s);
+        const char* who = "porosity_estimator::restore";
+        const std::size_t size = grid_.field_size();
+        const char* what = "the grid's field size";
+        phi_.assign(s.array_named(who, "phi", size, what));
+        dphi_dt_.assign(s.array_named(who, "dphi_dt", size, what));
+        d_p_.assign(s.array_named(who, "d_p", size, what));
+        v_p_.assign(s.vectors_named(who, "v_p", size, what));
+        have_previous_ = s.count_named(who, "have_previous", 1) == 1;
     }
 
 private:

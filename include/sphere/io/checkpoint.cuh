@@ -14,6 +14,13 @@
 ///     sphere::write_checkpoint("run.ck", sim);
 ///     ...
 ///     auto sim2 = sphere::restart<sphere::simulation<double>>("run.ck");
+///
+/// A run coupled to the pore fluid stores the coupling's state too (format version 7, its
+/// optional fluid section) and restarts bit-identically with a coupling built as before:
+///
+///     sphere::write_checkpoint("run.ck", sim, coupling);
+///     ...
+///     auto sim2 = sphere::restart<sphere::simulation<double>>("run.ck", coupling2);
 #include <cerrno>
 #include <cmath>
 #include <cstddef>
@@ -23,6 +30,7 @@
 #include <ios>
 #include <iterator>
 #include <limits>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <type_traits>
@@ -35,6 +43,7 @@
 #include "../core/constants.cuh"
 #include "../core/error.cuh"
 #include "../core/vec.cuh"
+#include "../fluid/snapshot.cuh"
 #include "../particles/particle.cuh"
 #include "../particles/state.cuh"
 #include "../settings.cuh"
@@ -43,10 +52,10 @@
 
 namespace sphere {
 
-/// The checkpoint format version this build writes. It also reads version 5, which predates
-/// the bonds, and version 4, which predates the contact-law interface and holds the linear
-/// law's parameters without the law's name.
-inline constexpr std::uint32_t checkpoint_format_version = 6;
+/// The checkpoint format version this build writes. It also reads version 6, which predates
+/// the fluid section, version 5, which predates the bonds, and version 4, which predates the
+/// contact-law interface and holds the linear law's parameters without the law's name.
+inline constexpr std::uint32_t checkpoint_format_version = 7;
 
 /// The first 8 bytes of every checkpoint.
 inline constexpr char checkpoint_magic[9] = "SPHERECK";
@@ -58,6 +67,10 @@ struct checkpoint_data {
     settings<Real, typename Law::template params<Real>> config; ///< the settings; config.dt is the time step the run used (s)
     simulation_state<Real> state;      ///< every evolving field
     std::uint32_t written_precision = 0; ///< sizeof the writer's Real: 4 (float) or 8 (double)
+    std::uint32_t version = 0;           ///< the file's format version
+    /// The pore fluid's state (a fluid_coupling's snapshot()), where the file has a fluid
+    /// section (write_checkpoint(path, sim, coupling)); give it to the coupling's restore().
+    std::optional<fluid_snapshot<Real>> fluid;
 
     /// Particle descriptions from which a simulation with these settings is built before
     /// restore(state) (particle_snapshot::descriptions).
@@ -262,14 +275,73 @@ private:
     const std::string& path_;
 };
 
+/// The fluid section of a version 7 checkpoint after its flag (encode_checkpoint): a
+/// fluid_snapshot, its values converted to Real. Refuses, naming what, a grid that
+/// fluid_grid::make would refuse and entries that do not fit in the payload or share a name.
+template <class Real>
+fluid_snapshot<Real> decode_fluid_section(checkpoint_decoder& d)
+{
+    fluid_snapshot<Real> f;
+    f.model = d.text("the fluid model's name", 4096);
+    std::uint64_t cells = 1;
+    for (int a = 0; a < 3; ++a) {
+        f.n[a] = d.u32("the fluid grid's cell counts");
+        if (f.n[a] < 1) d.inconsistent("the fluid grid has ", f.n[a], " cells along axis ", a, ", at least 1 is valid");
+        cells *= f.n[a];
+        if (cells > (std::uint64_t(1) << 28)) d.inconsistent("the fluid grid has more than 2^28 cells");
+    }
+    for (int a = 0; a < 3; ++a) f.lo[a] = d.f64("the fluid grid's box");
+    for (int a = 0; a < 3; ++a) {
+        f.hi[a] = d.f64("the fluid grid's box");
+        if (!(std::isfinite(f.lo[a]) && std::isfinite(f.hi[a]) && f.lo[a] < f.hi[a]))
+            d.inconsistent("the fluid grid spans [", f.lo[a], ", ", f.hi[a], "] m along axis ", a);
+    }
+    // Each entry takes at least its name's length (8 bytes) and 8 bytes of value or count.
+    const auto entries = [&d](const char* what) {
+        const std::uint64_t n = d.u64(what);
+        if (n > d.left() / 16) d.inconsistent(what, " is ", n, ", but ", d.left(), " bytes are left");
+        return static_cast<std::size_t>(n);
+    };
+    const auto unique = [&d](const auto& list, const std::string& name, const char* kind) {
+        for (const auto& e : list)
+            if (e.name == name) d.inconsistent("the fluid section holds two ", kind, " named \"", name, "\"");
+    };
+    const std::size_t arrays = entries("the fluid array count");
+    for (std::size_t k = 0; k < arrays; ++k) {
+        const std::string name = d.text("a fluid array's name", 4096);
+        unique(f.arrays, name, "arrays");
+        const std::string what = "the fluid array \"" + name + "\"";
+        const std::uint64_t n = d.u64(what.c_str());
+        if (n > d.left() / 8)
+            d.inconsistent(what, ": ", n, " values of 8 bytes do not fit in the ", d.left(), " bytes left");
+        std::vector<Real> values(static_cast<std::size_t>(n));
+        for (Real& v : values) v = Real(d.f64(what.c_str()));
+        f.arrays.push_back({name, std::move(values)});
+    }
+    const std::size_t numbers = entries("the fluid number count");
+    for (std::size_t k = 0; k < numbers; ++k) {
+        const std::string name = d.text("a fluid number's name", 4096);
+        unique(f.numbers, name, "numbers");
+        f.numbers.push_back({name, d.f64(("the fluid number \"" + name + "\"").c_str())});
+    }
+    const std::size_t counts = entries("the fluid count count");
+    for (std::size_t k = 0; k < counts; ++k) {
+        const std::string name = d.text("a fluid count's name", 4096);
+        unique(f.counts, name, "counts");
+        f.counts.push_back({name, d.u64(("the fluid count \"" + name + "\"").c_str())});
+    }
+    return f;
+}
+
 } // namespace detail
 
 /// The bytes of a checkpoint (the layout of docs/io.md) for a simulation with the contact law
 /// `Law`, its settings `config`, the time step `dt` (s) the run uses (stored in place of
-/// config.dt) and a state.
+/// config.dt) and a state, and, unless `fluid` is null, the pore fluid's state (a
+/// fluid_coupling's snapshot()) in the fluid section.
 template <class Law = contact::linear<>, class Real>
 std::string encode_checkpoint(const settings<Real, typename Law::template params<Real>>& config, Real dt,
-                              const simulation_state<Real>& s)
+                              const simulation_state<Real>& s, const fluid_snapshot<Real>* fluid = nullptr)
 {
     using detail::checkpoint_encoder;
     const std::size_t n = s.particles.size();
@@ -358,6 +430,30 @@ std::string encode_checkpoint(const settings<Real, typename Law::template params
     for (const auto* field : {&b.released, &b.dissipated}) e.array(*field, put_real);
     for (const auto* field : {&b.force, &b.torque_i, &b.torque_j}) e.array(*field, put_v3);
 
+    // The pore fluid (format 7): a flag, then the snapshot's model, grid and named entries.
+    e.u32(fluid ? 1u : 0u);
+    if (fluid) {
+        e.text(fluid->model);
+        for (int a = 0; a < 3; ++a) e.u32(fluid->n[a]);
+        for (int a = 0; a < 3; ++a) e.f64(fluid->lo[a]);
+        for (int a = 0; a < 3; ++a) e.f64(fluid->hi[a]);
+        e.u64(fluid->arrays.size());
+        for (const auto& a : fluid->arrays) {
+            e.text(a.name);
+            e.array(a.values, put_real);
+        }
+        e.u64(fluid->numbers.size());
+        for (const auto& x : fluid->numbers) {
+            e.text(x.name);
+            e.f64(x.value);
+        }
+        e.u64(fluid->counts.size());
+        for (const auto& x : fluid->counts) {
+            e.text(x.name);
+            e.u64(x.value);
+        }
+    }
+
     const std::uint64_t payload = e.bytes.size() - detail::checkpoint_header_bytes;
     for (int k = 0; k < 8; ++k) e.bytes[16 + k] = static_cast<char>((payload >> (8 * k)) & 0xffu);
     e.u64(detail::fnv1a64(e.bytes.data(), e.bytes.size()));
@@ -385,9 +481,9 @@ checkpoint_data<Real, Law> decode_checkpoint(const std::string& bytes, const std
     const std::uint32_t version = head.u32("the format version");
     using params = typename Law::template params<Real>;
     constexpr bool linear_params = std::is_same_v<params, contact_params<Real>>;
-    if (version != checkpoint_format_version && version != 5 && !(version == 4 && linear_params))
+    if (version != checkpoint_format_version && version != 6 && version != 5 && !(version == 4 && linear_params))
         detail::fail("checkpoint '", path, "': format version ", version, ", but this build reads versions ",
-                     checkpoint_format_version, " and 5", version == 4 ? ", and 4 only for the linear contact law, "
+                     checkpoint_format_version, ", 6 and 5", version == 4 ? ", and 4 only for the linear contact law, "
                                                                        "which version 4 describes"
                                                                      : ", and 4 for the linear contact law");
     const std::uint32_t precision = head.u32("the writer's precision");
@@ -417,6 +513,7 @@ checkpoint_data<Real, Law> decode_checkpoint(const std::string& bytes, const std
 
     checkpoint_data<Real, Law> c;
     c.written_precision = precision;
+    c.version = version;
     if (version >= 5) {
         const std::string law = d.text("the contact law's name", 4096);
         const std::string history = d.text("the contact history's layout", 4096);
@@ -536,6 +633,7 @@ checkpoint_data<Real, Law> decode_checkpoint(const std::string& bytes, const std
                 d.inconsistent("bond ", k, " joins particles ", b.i[k], " and ", b.j[k], " (", n,
                                " particles) with broken flag ", unsigned(b.broken[k]), " (0 or 1)");
     }
+    if (version >= 7 && d.choice("the fluid section's flag", 1) == 1) c.fluid = detail::decode_fluid_section<Real>(d);
     if (d.left() != 0) d.inconsistent(d.left(), " bytes follow the last array");
     for (std::size_t i = 0; i < n; ++i)
         for (std::size_t e = t.begin(i); e < t.end(i); ++e) {
@@ -571,6 +669,18 @@ void write_checkpoint(const std::string& path, const Sim& sim)
     write_checkpoint<typename Sim::law_type>(path, sim.config(), sim.dt(), sim.state());
 }
 
+/// Writes a checkpoint of a simulation and the pore fluid coupled to it (a fluid_coupling:
+/// its snapshot(), in the fluid section) to `path` atomically; sphere::restart(path, coupling)
+/// continues both. Throws sphere::error naming the file when it cannot be written.
+template <class Sim, class Coupling>
+void write_checkpoint(const std::string& path, const Sim& sim, Coupling& coupling)
+{
+    const auto fluid = coupling.snapshot();
+    static_assert(std::is_same_v<std::decay_t<decltype(fluid)>, fluid_snapshot<typename Sim::real_type>>,
+                  "write_checkpoint(path, sim, coupling): the coupling's precision must be the simulation's");
+    write_file_atomically(path, encode_checkpoint<typename Sim::law_type>(sim.config(), sim.dt(), sim.state(), &fluid));
+}
+
 /// Reads a checkpoint into the precision Real (values converted when the writer used the
 /// other one). Throws sphere::error `checkpoint '<path>': ...` when the file cannot be opened or
 /// read, or for any of the reasons of decode_checkpoint.
@@ -587,6 +697,21 @@ checkpoint_data<Real, Law> read_checkpoint(const std::string& path)
     return decode_checkpoint<Real, Law>(bytes, path);
 }
 
+namespace detail {
+/// A simulation of type Sim built from a checkpoint's settings and particles, then restored
+/// to its state (restart).
+template <class Sim>
+Sim restart_from(const checkpoint_data<typename Sim::real_type, typename Sim::law_type>& c)
+{
+    using Real = typename Sim::real_type;
+    typename Sim::settings_type config = c.config;
+    config.max_initial_overlap = std::numeric_limits<Real>::infinity(); // the state was accepted when it began
+    Sim sim(config, c.particles());
+    sim.restore(c.state);
+    return sim;
+}
+} // namespace detail
+
 /// A simulation of type Sim (e.g. sphere::simulation<float>) continuing from the checkpoint
 /// at `path`: built from its settings and particles, then restored to its state. Observers
 /// are not part of a checkpoint; add them again. Throws sphere::error for an unreadable
@@ -595,11 +720,35 @@ template <class Sim>
 Sim restart(const std::string& path)
 {
     using Real = typename Sim::real_type;
+    return detail::restart_from<Sim>(read_checkpoint<Real, typename Sim::law_type>(path));
+}
+
+/// restart(path), and the pore fluid coupled to the simulation restored from the checkpoint's
+/// fluid section (write_checkpoint(path, sim, coupling)). With `coupling` built as the written
+/// run's was (grid, model and its parameters, options, drag law and pressure solver; none of
+/// them is stored; the grid and the model are checked), the two continue bit-identically on the
+/// host backend with the same precision and thread count (docs/fluid.md, *Restarting a coupled
+/// run*). Throws sphere::error `checkpoint '<path>': ...` for the reasons of restart(path),
+/// for a file without a fluid section, and for a fluid section the coupling's restore()
+/// refuses (another model or grid, entries missing or unknown, arrays of another length);
+/// the coupling is unchanged then.
+template <class Sim, class Coupling>
+Sim restart(const std::string& path, Coupling& coupling)
+{
+    using Real = typename Sim::real_type;
     const checkpoint_data<Real, typename Sim::law_type> c = read_checkpoint<Real, typename Sim::law_type>(path);
-    typename Sim::settings_type config = c.config;
-    config.max_initial_overlap = std::numeric_limits<Real>::infinity(); // the state was accepted when it began
-    Sim sim(config, c.particles());
-    sim.restore(c.state);
+    if (!c.fluid)
+        detail::fail("checkpoint '", path, "': no fluid section (format version ", c.version,
+                     c.version >= 7 ? ", written without a coupling" : ", which has none",
+                     "); a coupled run is written by write_checkpoint(path, sim, coupling)");
+    Sim sim = detail::restart_from<Sim>(c);
+    try {
+        coupling.restore(*c.fluid);
+    } catch (const error& e) {
+        const std::string message = e.what(), prefix = "sphere: ";
+        detail::fail("checkpoint '", path, "': ",
+                     message.compare(0, prefix.size(), prefix) == 0 ? message.substr(prefix.size()) : message);
+    }
     return sim;
 }
 

@@ -25,6 +25,7 @@
 #include "../core/error.cuh"
 #include "../core/vec.cuh"
 #include "../fluid/coupling.cuh"
+#include "../fluid/darcy.cuh"
 #include "../fluid/grid.cuh"
 #include "../fluid/navier_stokes.cuh"
 #include "atomic_file.cuh"
@@ -53,10 +54,18 @@ vti_fields<Real> fluid_fields(const navier_stokes<Real, Policy, Poisson>& fluid)
     return {fluid.grid(), fluid.pressure(), fluid.cell_velocity(), fluid.porosity(), {}};
 }
 
-/// The fields of a coupled fluid: its solver's, and the porosity rate of the coupling's
+/// The fields of the Darcy model: pressure(), cell_velocity() (the fluid's, v_s + q / phi),
+/// porosity(); no porosity rate.
+template <class Real, class Policy, class Poisson>
+vti_fields<Real> fluid_fields(darcy_flow<Real, Policy, Poisson>& fluid)
+{
+    return {fluid.grid(), fluid.pressure(), fluid.cell_velocity(), fluid.porosity(), {}};
+}
+
+/// The fields of a coupled fluid: its model's, and the porosity rate of the coupling's
 /// porosity estimator (the rate the last fluid step used).
-template <class Real, class Policy, class Drag, class Poisson>
-vti_fields<Real> fluid_fields(fluid_coupling<Real, Policy, Drag, Poisson>& coupling)
+template <class Real, class Policy, class Drag, class Poisson, template <class, class, class> class Model>
+vti_fields<Real> fluid_fields(fluid_coupling<Real, Policy, Drag, Poisson, Model>& coupling)
 {
     vti_fields<Real> f = fluid_fields(coupling.fluid());
     f.porosity_rate = coupling.porosity().fields().dphi_dt;
@@ -139,9 +148,16 @@ void write_vti(const std::string& path, const navier_stokes<Real, Policy, Poisso
     write_vti(path, fluid_fields(fluid), time);
 }
 
-/// Writes the fields of a coupled fluid, with the porosity rate, at time `time` (s).
-template <class Real, class Policy, class Drag, class Poisson>
-void write_vti(const std::string& path, fluid_coupling<Real, Policy, Drag, Poisson>& coupling, double time)
+/// Writes the fields of the Darcy model (no porosity_rate) at time `time` (s).
+template <class Real, class Policy, class Poisson>
+void write_vti(const std::string& path, darcy_flow<Real, Policy, Poisson>& fluid, double time)
+{
+    write_vti(path, fluid_fields(fluid), time);
+}
+
+/// Writes the fields of a coupled fluid (either model), with the porosity rate, at time `time` (s).
+template <class Real, class Policy, class Drag, class Poisson, template <class, class, class> class Model>
+void write_vti(const std::string& path, fluid_coupling<Real, Policy, Drag, Poisson, Model>& coupling, double time)
 {
     write_vti(path, fluid_fields(coupling), time);
 }
@@ -164,7 +180,7 @@ public:
         if (ec) detail::fail("vti_writer: cannot create the output folder '", folder_, "': ", ec.message());
     }
 
-    /// Writes the next frame of `source` (vti_fields, a navier_stokes solver or a
+    /// Writes the next frame of `source` (vti_fields, a navier_stokes or darcy_flow solver or a
     /// fluid_coupling) at time `time` (s), adds it to the .pvd and rewrites that; returns the
     /// .vti path.
     template <class Source>
