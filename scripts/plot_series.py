@@ -5,7 +5,9 @@ Usage: /usr/bin/python3 scripts/plot_series.py SERIES.csv [--out DIR]
 
 The CSV has a header line of `name_unit` columns and rows of numbers. Columns read:
   required   time_s, kinetic_J, rotational_J, potential_J, elastic_J, dissipated_visc_J,
-             dissipated_fric_J, boundary_work_J, total_J
+             dissipated_fric_J, boundary_work_J, total_J; or, instead, the Terzaghi columns
+  terzaghi   time_s, settlement_m, terzaghi_settlement_m, excess_p_bottom_Pa,
+             terzaghi_excess_p_bottom_Pa (fluid_consolidation's terzaghi.csv)
   walls      wall_<face>_position_m, wall_<face>_force_N (face: xlo xhi ylo yhi zlo zhi);
              normal_stress_Pa
   porosity   porosity, void_ratio (derived from porosity when absent)
@@ -13,11 +15,14 @@ The CSV has a header line of `name_unit` columns and rows of numbers. Columns re
 Other columns (wall velocities, side_stress_Pa, axial_strain, ...) are read but not plotted.
 
 Figures, written to DIR (default: the CSV's folder), one printed line (the path) each:
-  energy.png    energy budget and the balance total_J - total_J[0] against time (always)
+  energy.png    energy budget and the balance total_J - total_J[0] against time (when the
+                energy columns exist)
   walls.png     positions and forces of the moving walls, normal stress (when wall columns exist)
   porosity.png  porosity and void ratio against time (when `porosity` exists)
   shear.png     shear stress, friction coefficient and dilation against shear strain
                 (when `shear_strain` exists)
+  terzaghi.png  settlement and the bottom's excess pore pressure against Terzaghi's (when the
+                Terzaghi columns exist)
 Errors (unreadable file, bad header or row, no rows) print one message naming the file to
 stderr and exit with status 2, before any figure is written.
 """
@@ -32,6 +37,8 @@ import numpy as np  # noqa: E402
 
 ENERGY_COLUMNS = ["time_s", "kinetic_J", "rotational_J", "potential_J", "elastic_J",
                   "dissipated_visc_J", "dissipated_fric_J", "boundary_work_J", "total_J"]
+TERZAGHI_COLUMNS = ["time_s", "settlement_m", "terzaghi_settlement_m", "excess_p_bottom_Pa",
+                    "terzaghi_excess_p_bottom_Pa"]
 FACES = ["xlo", "xhi", "ylo", "yhi", "zlo", "zhi"]
 
 
@@ -52,7 +59,7 @@ def read_series(path):
     if len(set(names)) != len(names):
         raise SeriesError(f"'{path}' line 1: repeated column name in the header")
     missing = [c for c in ENERGY_COLUMNS if c not in names]
-    if missing:
+    if missing and not all(c in names for c in TERZAGHI_COLUMNS):
         raise SeriesError(f"'{path}' line 1: header lacks the column(s) {', '.join(missing)}")
     rows = []
     for number, line in enumerate(lines[1:], start=2):
@@ -168,6 +175,22 @@ def plot_shear(s):
     return fig
 
 
+def plot_terzaghi(s):
+    t = s["time_s"]
+    fig, (top, bottom) = plt.subplots(2, 1, sharex=True, figsize=(9, 7))
+    top.plot(t, s["settlement_m"] * 1e3, color="C0", label="settlement")
+    top.plot(t, s["terzaghi_settlement_m"] * 1e3, color="C0", linestyle="--", label="Terzaghi")
+    top.set_ylabel("settlement [mm]")
+    top.legend(fontsize="small")
+    bottom.plot(t, s["excess_p_bottom_Pa"] / 1e3, color="C1", label="excess pore pressure, bottom")
+    bottom.plot(t, s["terzaghi_excess_p_bottom_Pa"] / 1e3, color="C1", linestyle="--", label="Terzaghi")
+    bottom.set_ylabel("excess pore pressure [kPa]")
+    bottom.set_xlabel("time after the load [s]")
+    bottom.legend(fontsize="small")
+    fig.suptitle("Consolidation against Terzaghi")
+    return fig
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description="Plot a sphere CSV time series as PNG figures.")
     parser.add_argument("csv", help="the CSV time series")
@@ -176,7 +199,11 @@ def main(argv=None):
     out = args.out if args.out is not None else (os.path.dirname(args.csv) or ".")
     try:
         s = read_series(args.csv)
-        figures = [("energy.png", plot_energy)]
+        figures = []
+        if all(c in s for c in ENERGY_COLUMNS):
+            figures.append(("energy.png", plot_energy))
+        if all(c in s for c in TERZAGHI_COLUMNS):
+            figures.append(("terzaghi.png", plot_terzaghi))
         if any(name.startswith("wall_") for name in s):
             figures.append(("walls.png", plot_walls))
         if "porosity" in s:

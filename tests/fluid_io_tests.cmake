@@ -75,15 +75,28 @@ foreach(_example IN ITEMS settling permeability)
 endforeach()
 
 # Consolidation with pore fluid (examples/fluid_consolidation): 100 particles, 0.1 s of loading
-# (a few seconds). The one regex ('.' spans lines in CMake) asks for a positive peak excess pore
-# pressure at the bottom and the final "output in ..." line.
+# (a few seconds), with the Darcy model (the default) and with Navier-Stokes. The one regex ('.'
+# spans lines in CMake) asks for a positive peak excess pore pressure at the bottom and the
+# final "output in ..." line; scripts/plot_series.py then draws terzaghi.csv (the settlement and
+# the bottom's excess pressure against Terzaghi's).
 if(TARGET fluid_consolidation)
-    add_test(NAME example_fluid_consolidation
-        COMMAND fluid_consolidation -n 100 --time 0.1 --rest 0.005 --output-interval 0.01
-                -q -o "${CMAKE_CURRENT_BINARY_DIR}/example_fluid_consolidation")
-    set_tests_properties(example_fluid_consolidation PROPERTIES
+    foreach(_model IN ITEMS darcy navier-stokes)
+        set(_name example_fluid_consolidation_${_model})
+        add_test(NAME ${_name}
+            COMMAND fluid_consolidation -n 100 --time 0.1 --rest 0.005 --output-interval 0.01 --model ${_model}
+                    -q -o "${CMAKE_CURRENT_BINARY_DIR}/${_name}")
+        set_tests_properties(${_name} PROPERTIES
+            LABELS example
+            ENVIRONMENT "${SPHERE_TEST_ENVIRONMENT}"
+            TIMEOUT 300
+            FIXTURES_SETUP ${_name}_output
+            PASS_REGULAR_EXPRESSION "peak excess pore pressure at the bottom \\(Pa\\) +[1-9][0-9]*\\.[0-9]+ .*output in .*${_name}/: particles.pvd \\([0-9]+ frames?\\), fluid.pvd \\([0-9]+ frames?\\), series.csv \\([0-9]+ rows?\\), terzaghi.csv \\([1-9][0-9]* rows?\\)")
+    endforeach()
+    add_test(NAME example_fluid_consolidation_plot
+        COMMAND "${SPHERE_VTK_PYTHON}" "${PROJECT_SOURCE_DIR}/scripts/plot_series.py"
+                "${CMAKE_CURRENT_BINARY_DIR}/example_fluid_consolidation_darcy/terzaghi.csv")
+    set_tests_properties(example_fluid_consolidation_plot PROPERTIES
         LABELS example
-        ENVIRONMENT "${SPHERE_TEST_ENVIRONMENT}"
-        TIMEOUT 300
-        PASS_REGULAR_EXPRESSION "peak excess pore pressure at the bottom \\(Pa\\) +[1-9][0-9]*\\.[0-9]+ .*output in .*example_fluid_consolidation/: particles.pvd \\([0-9]+ frames?\\), fluid.pvd \\([0-9]+ frames?\\), series.csv \\([0-9]+ rows?\\)")
+        FIXTURES_REQUIRED example_fluid_consolidation_darcy_output
+        PASS_REGULAR_EXPRESSION "terzaghi.png")
 endif()

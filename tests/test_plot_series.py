@@ -19,7 +19,7 @@ import matplotlib.image  # noqa: E402
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 ENERGY = ["time_s", "kinetic_J", "rotational_J", "potential_J", "elastic_J",
           "dissipated_visc_J", "dissipated_fric_J", "boundary_work_J", "total_J"]
-FIGURES = ["energy.png", "walls.png", "porosity.png", "shear.png"]
+FIGURES = ["energy.png", "walls.png", "porosity.png", "shear.png", "terzaghi.png"]
 
 
 def fail(message):
@@ -69,6 +69,18 @@ def shear(path, n=60):
         gamma = 0.005 * i
         tau = 5e3 * (1 - math.exp(-gamma / 0.03))
         rows.append(energy_row(i, n) + [gamma, tau, tau / 1e4, 2e-5 * math.tanh(gamma / 0.05), 1e4])
+    write_csv(path, columns, rows)
+
+
+def terzaghi(path, n=40):
+    """fluid_consolidation's terzaghi.csv: no energy columns."""
+    columns = ["time_s", "settlement_m", "terzaghi_settlement_m", "excess_p_bottom_Pa",
+               "terzaghi_excess_p_bottom_Pa"]
+    rows = []
+    for i in range(n):
+        t = 0.01 * i
+        rows.append([t, 1e-3 * (1 - math.exp(-t / 0.1)), 1e-3 * (1 - math.exp(-t / 0.12)),
+                     1e4 * math.exp(-t / 0.1), 1e4 * math.exp(-t / 0.12)])
     write_csv(path, columns, rows)
 
 
@@ -144,6 +156,11 @@ def main():
                       ["--out", out])
         if pngs(folder):
             fail(f"--out given, yet figures were written next to the CSV: {pngs(folder)}")
+        # Terzaghi: the settlement and pressure figure alone (no energy columns needed).
+        folder = os.path.join(tmp, "terzaghi")
+        os.mkdir(folder)
+        terzaghi(os.path.join(folder, "terzaghi.csv"))
+        check_figures(script, os.path.join(folder, "terzaghi.csv"), folder, ["terzaghi.png"])
 
         # Errors: exit status 2, the file named, no PNG written.
         header = ",".join(ENERGY)

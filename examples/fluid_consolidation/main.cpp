@@ -1,14 +1,15 @@
 // fluid_consolidation: consolidation with pore fluid (docs/examples.md). A sample poured under
 // gravity (examples/common/granular.hpp, periodic in x and y) is saturated with a viscous pore
-// fluid on a fluid grid over the world box (sphere::fluid_coupling, docs/fluid.md), drained at
-// the top (p = 0 on the top cell layer, above the sample) and undrained at the bottom (no
-// flow). After a short rest the upper wall loads the sample at a normal stress: the fluid
+// fluid on a fluid grid over the world box (sphere::fluid_coupling, docs/fluid.md: the Darcy
+// model by default, or Navier-Stokes), drained at the top (p = 0 on the top cell layer, above
+// the sample) and undrained at the bottom (no flow). After a short rest the upper wall loads the sample at a normal stress: the fluid
 // cannot leave the pores at once, so the excess pore pressure (p minus the hydrostatic
 // rho_f g (z_top - z)) rises and then decays as the fluid drains through the top while the
 // sample settles (Terzaghi consolidation, time ~ H^2 mu / (k M)). Writes particle frames
-// (.vtu), fluid frames (.vti) and a CSV series of the wall, the porosity and the excess pore
-// pressures; prints the peak excess pressure at the bottom, its value at the end and the
-// settlement.
+// (.vtu), fluid frames (.vti), a CSV series of the wall, the porosity and the excess pore
+// pressures, and terzaghi.csv, the settlement and the bottom's excess pressure next to
+// Terzaghi's for the sample's measured modulus; prints the peak excess pressure at the
+// bottom, its value at the end and the settlement.
 #include "../common/granular.hpp"
 
 #include <sphere/fluid.cuh>
@@ -21,13 +22,16 @@
 #include <cstdio>
 #include <limits>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 namespace {
 
 struct options {
     granular::sample_options sample;
-    double stress = 1e4;            // Pa
+    double stress = 1e4;            // Pa: the load step, on top of the preload
+    double preload = 1e4;           // Pa: the dry sample's stress before the fluid
+    double preload_time = 0.1;      // s of dry preloading
     double duration = 0.6;          // s of loading
     double rest = 0.02;             // s with the fluid before the load
     double viscosity = 10;          // Pa s
@@ -35,6 +39,8 @@ struct options {
     double cell_diameters = 2.5;    // fluid cell width in mean particle diameters
     unsigned dem_steps = 0;         // DEM steps per fluid step; 0: automatic
     double safety = 0.2;            // automatic fluid step: this fraction of the smallest limit
+    std::string model = "darcy";    // darcy or navier-stokes
+    double compressibility = 4.5e-10; // Darcy: pore fluid compressibility (1/Pa)
 };
 
 /// What one output row holds.
@@ -48,26 +54,57 @@ struct state {
     double mean = 0;        ///< ... mean of the layers whose centres lie in the sample (Pa)
 };
 
-template <class Real>
+/// Terzaghi's excess pore pressure over its initial value at the closed end of a layer
+/// drained at the other, at time factor T = c_v t / H^2: sum 2/M sin(M) exp(-M^2 T).
+double terzaghi_closed_end(double T)
+{
+    double sum = 0;
+    for (int m = 0; m < 200; ++m) {
+        const double M = sphere::pi<double> * (2 * m + 1) / 2;
+        sum += 2 / M * std::sin(M) * std::exp(-M * M * T);
+    }
+    return sum;
+}
+
+/// Terzaghi's degree of consolidation U(T) = 1 - sum 2/M^2 exp(-M^2 T).
+double terzaghi_degree(double T)
+{
+    double sum = 0;
+    for (int m = 0; m < 200; ++m) {
+        const double M = sphere::pi<double> * (2 * m + 1) / 2;
+        sum += 2 / (M * M) * std::exp(-M * M * T);
+    }
+    return 1 - sum;
+}
+
+template <class Real, template <class, class, class> class Model>
 int run(const options& o)
 {
     using namespace sphere;
     using Sim = granular::granular_sim<Real>;
     using Drag = drag::gidaspow;
-    using Coupling = fluid_coupling<Real, host, Drag, cg_poisson<Real, host>>;
+    using Coupling = fluid_coupling<Real, host, Drag, cg_poisson<Real, host>, Model>;
+    constexpr bool darcy = std::is_same_v<typename Coupling::model_type, darcy_flow<Real, host, cg_poisson<Real, host>>>;
     const auto clock_start = std::chrono::steady_clock::now();
 
     Sim sim = granular::deposited_sample<Real>(o.sample, false, granular::contact_of<Real>(o.sample));
+    const double deposited = sim.time();
+    // The dry preload: the loose deposit compacts under it (most of its plastic strain), so
+    // that the load step meets a stiffer, nearly elastic skeleton, Terzaghi's assumption.
+    if (o.preload > 0) {
+        sim.set_wall_control(5, granular::stress_wall(o.sample, sim, o.preload));
+        sim.run(std::size_t(std::ceil(o.preload_time / double(sim.dt()))));
+    }
     const world<Real> box = sim.config().box;
     const double z_bottom = sim.walls().face[4].position;
     const double z_sample = sim.walls().face[5].position;
     const double height = z_sample - z_bottom;
     const double d = 2 * o.sample.radius;
     const double g = -double(sim.config().gravity.z);
-    std::printf("fluid_consolidation: %zu particles (%s), deposited in %.3f s; sample %.4f m high "
-                "(walls at %.4f and %.4f m), porosity %.4f\n",
-                sim.size(), o.sample.precision.c_str(), sim.time(), height, z_bottom, z_sample,
-                bulk_porosity(sim).porosity);
+    std::printf("fluid_consolidation: %zu particles (%s), deposited in %.3f s, preloaded dry at %.0f Pa for %.3f s; "
+                "sample %.4f m high (walls at %.4f and %.4f m), porosity %.4f\n",
+                sim.size(), o.sample.precision.c_str(), deposited, o.preload, o.preload > 0 ? o.preload_time : 0.0,
+                height, z_bottom, z_sample, bulk_porosity(sim).porosity);
 
     // Fluid grid over the world box: near-cubic cells of about cell_diameters mean diameters,
     // at least 3 across (the porosity estimator's periodic check) and along z.
@@ -93,11 +130,25 @@ int run(const options& o)
     prm.top = fluid_boundary<Real>::prescribed_pressure(0);
     prm.poisson.tolerance = sizeof(Real) == 8 ? 1e-10 : 1e-4;
 
-    // The fluid time step: below the diffusive limit of the fluid (navier_stokes::
-    // stable_time_step() for the sample's porosity) and the particle response time
-    // m / (drag coefficient) the coupling checks, both for the porosity of the deposited
-    // sample, by the factor `safety` (the sample compacts; the collective response of the
-    // pressure is faster than one particle's).
+    // The Darcy model's parameters: Carman's Kozeny-Carman constant d^2 / 180 for the mean
+    // diameter, the pore fluid's compressibility.
+    const auto params = [&]() {
+        if constexpr (darcy) {
+            darcy_params<Real> dp;
+            dp.fluid = prm;
+            dp.compressibility = Real(o.compressibility);
+            dp.permeability_prefactor = Real(d * d / 180);
+            return dp;
+        } else {
+            return prm;
+        }
+    }();
+
+    // The fluid time step, by the factor `safety` below the particle response time to the
+    // fluid for the porosity of the deposited sample (the sample compacts; the collective
+    // response of the pressure is faster than one particle's): m / (drag coefficient) for
+    // Navier-Stokes, rho_s (1 - phi) k / (mu phi) for Darcy; and for Navier-Stokes below its
+    // diffusive limit (navier_stokes::stable_time_step()).
     double response = std::numeric_limits<double>::infinity(), phi_min = 1;
     {
         const particle_snapshot<Real> snap = sim.snapshot();
@@ -109,34 +160,42 @@ int run(const options& o)
             int cell[3];
             grid.cell_of(snap.position(i), cell);
             const std::size_t c = grid.field_index(cell[0], cell[1], cell[2]);
-            const double beta = double(Drag::beta_per_solid(por.phi[c], por.d_p[c], Real(0), prm.density, prm.viscosity));
-            response = std::min(response, o.sample.density / beta);
+            double r = 0;
+            if constexpr (darcy) {
+                const double phi = std::min(double(por.phi[c]), double(params.max_porosity));
+                r = o.sample.density * (1 - phi) * double(params.permeability(Real(phi))) / (o.viscosity * phi);
+            } else {
+                r = o.sample.density /
+                    double(Drag::beta_per_solid(por.phi[c], por.d_p[c], Real(0), prm.density, prm.viscosity));
+            }
+            response = std::min(response, r);
         }
     }
     coupling_options opt;
-    Coupling probe(grid, prm, opt);
-    {
+    double diffusive = std::numeric_limits<double>::infinity();
+    if constexpr (!darcy) {
+        Coupling probe(grid, params, opt);
         porosity_estimator<Real, host> est(grid);
         est.update(sim.snapshot(), Real(1));
         probe.fluid().set_porosity(est.view());
+        diffusive = double(probe.fluid().stable_time_step());
     }
-    const double diffusive = double(probe.fluid().stable_time_step());
     const double dt = double(sim.dt());
     const double limit = std::min(response, diffusive);
     opt.dem_steps = o.dem_steps > 0 ? o.dem_steps : unsigned(std::max(1.0, std::floor(o.safety * limit / dt)));
     const double dt_f = opt.dem_steps * dt;
-    Coupling coupled(grid, prm, opt);
+    Coupling coupled(grid, params, opt);
 
     // Consolidation time estimate: Kozeny-Carman permeability for the sample's porosity, the
     // 1D stiffness of the dry sample (measured at the end from the settlement).
     const double phi0 = bulk_porosity(sim).porosity;
     const double k_kc = phi0 * phi0 * phi0 * d * d / (180 * (1 - phi0) * (1 - phi0));
-    std::printf("fluid rho_f = %g kg/m^3, mu = %g Pa s; grid %u x %u x %u cells of %.4g m (%.2f diameters); "
-                "p = 0 on the top layer (z = %.4f m), no flow at the bottom\n",
-                o.fluid_density, o.viscosity, nx, ny, nz, h, h / d, z_top_layer);
+    std::printf("%s model; fluid rho_f = %g kg/m^3, mu = %g Pa s; grid %u x %u x %u cells of %.4g m (%.2f "
+                "diameters); p = 0 on the top layer (z = %.4f m), no flow at the bottom\n",
+                darcy ? "Darcy" : "Navier-Stokes", o.fluid_density, o.viscosity, nx, ny, nz, h, h / d, z_top_layer);
     std::printf("DEM dt = %.4g s; limits of the fluid step: particle response time %.4g s, fluid stability %.4g s "
                 "(min porosity %.3f)\n",
-                dt, response, diffusive, phi_min);
+                dt, response, diffusive, phi_min); // the Darcy step is unconditionally stable: inf
     std::printf("fluid dt = %.4g s = %u DEM steps (%s); Kozeny-Carman k = %.4g m^2 at porosity %.4f\n", dt_f,
                 opt.dem_steps, o.dem_steps > 0 ? "--dem-steps" : "automatic", k_kc, phi0);
     if (dt_f > limit)
@@ -208,11 +267,12 @@ int run(const options& o)
     const auto start = std::chrono::steady_clock::now();
     auto last = start;
     for (std::size_t n = 1; n <= fluid_steps; ++n) {
-        if (n == rest_steps + 1) {  // the load: the upper wall is stress-controlled from here
+        if (n == rest_steps + 1) {  // the load step on the upper wall
             t_load = sim.time();
             z_load = sim.walls().face[5].position;
-            sim.set_wall_control(5, granular::stress_wall(o.sample, sim, o.stress));
-            std::printf("load: %.0f Pa on the upper wall at t = %.4f s\n", o.stress, t_load);
+            sim.set_wall_control(5, granular::stress_wall(o.sample, sim, o.preload + o.stress));
+            std::printf("load: %.0f Pa more on the upper wall (%.0f Pa) at t = %.4f s\n", o.stress, o.preload + o.stress,
+                        t_load);
         }
         coupled.step(sim);
         // The first row after the first step (before it the fluid has no pressure yet).
@@ -267,10 +327,47 @@ int run(const options& o)
     std::printf("%-46s %14.4g\n", "consolidation time H^2 mu / (k_KC M) (s)", t_c);
     if (t_fit > 0)
         std::printf("%-46s %14.4g  (pi^2/4 dt / ln(p50/p10))\n", "consolidation time from the decay (s)", t_fit);
+
+    // Terzaghi for this sample: height H at the load, K = k_KC / mu at its porosity, and the
+    // 1D compressibility m_v that makes Terzaghi's settlement at the end the measured one,
+    // m_v H ds U(T_end) (found by fixed-point iteration: T_end depends on m_v through c_v =
+    // K / (m_v + phi beta_f); beta_f = 0 for the incompressible Navier-Stokes fluid).
+    const double beta_f = darcy ? o.compressibility : 0.0;
+    const double K = k_kc / o.viscosity, t_end = end.time - t_load;
+    double m_v = strain / o.stress;
+    for (int it = 0; it < 100 && strain > 0; ++it) {
+        const double T_end = K / (m_v + phi0 * beta_f) * t_end / (height * height);
+        m_v = strain / (o.stress * terzaghi_degree(T_end));
+    }
+    const double c_v = K / (m_v + phi0 * beta_f), p0 = o.stress * m_v / (m_v + phi0 * beta_f);
+    csv_series terzaghi(o.sample.out + "/terzaghi.csv",
+                        {"time_s", "settlement_m", "terzaghi_settlement_m", "excess_p_bottom_Pa",
+                         "terzaghi_excess_p_bottom_Pa"});
+    double worst_settlement = 0, worst_pressure = 0;
+    for (const state& r : rows) {
+        if (r.time < t_load) continue;
+        const double T = c_v * (r.time - t_load) / (height * height);
+        const double s_theory = m_v * height * (o.stress - p0 + p0 * terzaghi_degree(T));
+        const double p_theory = p0 * terzaghi_closed_end(T);
+        terzaghi.add_row({r.time - t_load, z_load - r.wall, s_theory, r.bottom, p_theory});
+        if (r.time == t_load) continue; // the load's instant: the pressure has not risen yet
+        worst_settlement = std::max(worst_settlement, std::abs(z_load - r.wall - s_theory));
+        worst_pressure = std::max(worst_pressure, std::abs(r.bottom - p_theory));
+    }
+    terzaghi.close();
+    std::printf("%-46s %14.4g  (c_v = %.4g m^2/s, m_v = %.4g 1/Pa)\n", "Terzaghi's consolidation time H^2 / c_v (s)",
+                height * height / c_v, c_v, m_v);
+    std::printf("%-46s %14.3f  of the settlement at the end (after the load's instant)\n",
+                "largest settlement - Terzaghi's",
+                settlement > 0 ? worst_settlement / settlement : 0.0);
+    std::printf("%-46s %14.3f  of the load (after the load's instant)\n", "largest bottom excess pressure - Terzaghi's",
+                worst_pressure / o.stress);
     std::printf("%-46s %14.1f\n", "wall-clock time (s)",
                 std::chrono::duration<double>(std::chrono::steady_clock::now() - clock_start).count());
-    std::printf("output in %s/: particles.pvd (%zu frames), fluid.pvd (%zu frames), series.csv (%zu rows)\n",
-                o.sample.out.c_str(), particles_out.collection().entries().size(), fluid_out.frames(), csv.rows());
+    std::printf("output in %s/: particles.pvd (%zu frames), fluid.pvd (%zu frames), series.csv (%zu rows), "
+                "terzaghi.csv (%zu rows)\n",
+                o.sample.out.c_str(), particles_out.collection().entries().size(), fluid_out.frames(), csv.rows(),
+                terzaghi.rows());
     return 0;
 }
 
@@ -285,7 +382,11 @@ int main(int argc, char** argv)
                  "bottom), then load it with the upper wall at a normal stress; writes the wall, the porosity and the "
                  "excess pore pressure against time"};
     granular::add_sample_options(app, o.sample);
-    app.add_option("--stress", o.stress, "normal stress of the upper wall (Pa)")->check(CLI::PositiveNumber)
+    app.add_option("--stress", o.stress, "the load step: normal stress added on the upper wall (Pa)")
+        ->check(CLI::PositiveNumber)->capture_default_str();
+    app.add_option("--preload", o.preload, "normal stress of the upper wall on the dry sample before the fluid (Pa; 0: none)")
+        ->check(CLI::NonNegativeNumber)->capture_default_str();
+    app.add_option("--preload-time", o.preload_time, "duration of the dry preload (s)")->check(CLI::PositiveNumber)
         ->capture_default_str();
     app.add_option("--time", o.duration, "duration of the loading (s)")->check(CLI::PositiveNumber)
         ->capture_default_str();
@@ -298,8 +399,15 @@ int main(int argc, char** argv)
     app.add_option("--cell-diameters", o.cell_diameters, "fluid cell width in mean particle diameters")
         ->check(CLI::Range(1.0, 100.0))->capture_default_str();
     app.add_option("--dem-steps", o.dem_steps, "DEM steps per fluid step (0: automatic)")->capture_default_str();
+    app.add_option("--model", o.model, "fluid model: darcy (pore pressure) or navier-stokes")
+        ->check(CLI::IsMember({"darcy", "navier-stokes"}))->capture_default_str();
+    app.add_option("--compressibility", o.compressibility, "Darcy model: pore fluid compressibility (1/Pa)")
+        ->check(CLI::PositiveNumber)->capture_default_str();
     app.add_option("--safety", o.safety, "automatic fluid step: this fraction of the smaller stability limit")
         ->check(CLI::Range(0.001, 1.0))->capture_default_str();
     CLI11_PARSE(app, argc, argv);
-    return granular::run_in_precision(o.sample, [&](auto real) { return run<decltype(real)>(o); });
+    return granular::run_in_precision(o.sample, [&](auto real) {
+        using Real = decltype(real);
+        return o.model == "darcy" ? run<Real, sphere::darcy_flow>(o) : run<Real, sphere::navier_stokes>(o);
+    });
 }

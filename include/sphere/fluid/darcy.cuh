@@ -272,6 +272,8 @@ struct darcy_particle_force {
 /// preconditioned by the constant-coefficient V-cycle; fewer iterations on large grids) or
 /// jacobi_poisson.
 ///
+/// The pressure starts hydrostatic from a prescribed-pressure end (rho_f g_z; 0 without one).
+///
 /// Boundaries (darcy_params::fluid.bottom / top): no_flow (no flux through the end face),
 /// pressure (the end cell layer holds p(t), as navier_stokes), inflow (a prescribed
 /// superficial velocity U = q through the end face; the other end must prescribe the
@@ -292,10 +294,19 @@ public:
             f.bottom.kind == fluid_boundary_kind::pressure || f.top.kind == fluid_boundary_kind::pressure;
         if (pressure_end && g.n[2] < 3)
             detail::fail("darcy: nz = ", g.n[2], " cells; a prescribed-pressure end needs nz >= 3");
-        set_layers(p_.data(), 0.0);
         for_each_index(Policy{}, grid_.cell_count(),
                        detail::darcy_take_porosity<Real>{view(), empty_porosity(), params_});
         fill_ghosts();
+        // The pressure starts hydrostatic from a prescribed-pressure end (the top's if both
+        // are), 0 without one: a coupled run's first forces are then buoyancy, not a
+        // seepage force of the whole weight of the fluid.
+        const bool top = f.top.kind == fluid_boundary_kind::pressure;
+        const int k_end = top ? int(g.n[2]) - 1 : 0;
+        const double p_end = top ? double(f.top.value(0)) : double(f.bottom.value(0));
+        const double z_end = double(g.centre(0, 0, k_end).z), rho_g = double(f.density) * double(f.gravity.z);
+        set_pressure([&](const vec3<Real>& x) {
+            return pressure_end ? Real(p_end + rho_g * (double(x.z) - z_end)) : Real(0);
+        });
     }
 
     const fluid_grid<Real>& grid() const { return grid_; }
