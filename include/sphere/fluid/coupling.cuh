@@ -5,14 +5,17 @@
 /// One coupled step of length dt_f = dem_steps x (DEM time step):
 ///   1. the porosity estimator bins the particles by fluid cell and computes each cell's
 ///      porosity, its rate, and the volume-weighted mean particle velocity and diameter;
-///   2. every particle gets the fluid force of its cell (the cell holding its centre)
+///   2. every particle gets the fluid force of its cell (the cell holding its centre) from
+///      the fluid model (its particle_forces): with navier_stokes
 ///        f_i = Drag::beta_per_solid(phi, d, |v_f - v_p|) (v_f - v_p) V_i  [ - V_i grad p ]
 ///      with the cell's porosity phi, fluid velocity v_f, mean particle velocity v_p and mean
 ///      diameter d (the particle's own velocity and diameter where the cell holds no
-///      solid); the bracket is the optional pressure-gradient (buoyancy) force;
-///   3. the fluid gets the opposite of the sum of its particles' forces, per unit cell volume,
-///      so that momentum is exchanged exactly (summed per cell in particle order:
-///      deterministic);
+///      solid), the bracket the optional pressure-gradient (buoyancy) force; with darcy_flow
+///      the Darcy force of darcy.cuh;
+///   3. the model takes the reaction (take_reaction): navier_stokes gets the opposite of the
+///      sum of its particles' forces, per unit cell volume, so that momentum is exchanged
+///      exactly (summed per cell in particle order: deterministic); darcy_flow has no fluid
+///      momentum (its pressure carries the exchange);
 ///   4. the fluid advances by dt_f (its own stability limits checked), then the DEM by
 ///      dem_steps steps with the forces held constant; the work the forces did on the free
 ///      particles (force times displacement) is added to work_on_particles().
