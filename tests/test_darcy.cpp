@@ -9,7 +9,8 @@
 //   times ([slow]);
 // - on a slow flow through a fixed bed the Darcy model and the Navier-Stokes solver with
 //   Ergun's drag give the same pressure gradient (k_c = d^2 / 150, Ergun's viscous term), and
-//   the fluid velocity written to .vti files is the flux over the porosity.
+//   the fluid velocity written to .vti files is the flux over the porosity; a fluid step beyond
+//   the Darcy force's response time is refused.
 #include <catch2/catch.hpp>
 
 #include <sphere/dem.cuh>
@@ -20,6 +21,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 #include <vector>
 
 namespace {
@@ -316,6 +318,27 @@ TEMPLATE_TEST_CASE("Darcy and Navier-Stokes agree on a slow flow through a fixed
     CHECK(gradient_darcy == Approx(gradient_ns).epsilon(0.01));
     CHECK(gradient_ns == Approx(ergun).epsilon(0.01));
     CHECK(gradient_darcy == Approx(ergun).epsilon(sizeof(Real) == 8 ? 1e-3 : 2e-3));
+    // The coupling refuses a fluid step beyond the Darcy force's response time (D-6),
+    // rho_s (1 - phi) k / (mu phi^2) = 0.0158 s here: 100 DEM steps of 0.5 ms.
+    {
+        sphere::coupling_options long_steps = opt;
+        long_steps.dem_steps = 100;
+        sphere::fluid_coupling<Real, sphere::host, sphere::drag::ergun, sphere::cg_poisson<Real, sphere::host>,
+                               sphere::darcy_flow>
+            too_long(grid, dprm, long_steps);
+        std::string message;
+        try {
+            too_long.step(sim_darcy);
+        } catch (const sphere::error& e) {
+            message = e.what();
+        }
+        const std::string key = "response time m / (drag coefficient) = ";
+        REQUIRE(message.find(key) != std::string::npos);
+        const double k = double(dprm.permeability(Real(phi)));
+        CHECK(std::stod(message.substr(message.find(key) + key.size())) ==
+              Approx(2600 * (1 - phi) * k / (mu * phi * phi)).epsilon(1e-4));
+    }
+
     // Every interior layer carries U; the fluid's velocity through the fixed bed, which the
     // .vti files hold, is U / phi.
     const std::vector<sphere::vec3<Real>> q = darcy.fluid().darcy_flux();

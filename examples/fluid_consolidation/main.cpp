@@ -147,7 +147,8 @@ int run(const options& o)
     // The fluid time step, by the factor `safety` below the particle response time to the
     // fluid for the porosity of the deposited sample (the sample compacts; the collective
     // response of the pressure is faster than one particle's): m / (drag coefficient) for
-    // Navier-Stokes, rho_s (1 - phi) k / (mu phi) for Darcy; and for Navier-Stokes below its
+    // Navier-Stokes, rho_s (1 - phi) k / (mu phi^2) for Darcy (docs/fluid.md (D-6)); and for
+    // Navier-Stokes below its
     // diffusive limit (navier_stokes::stable_time_step()).
     double response = std::numeric_limits<double>::infinity(), phi_min = 1;
     {
@@ -163,7 +164,7 @@ int run(const options& o)
             double r = 0;
             if constexpr (darcy) {
                 const double phi = std::min(double(por.phi[c]), double(params.max_porosity));
-                r = o.sample.density * (1 - phi) * double(params.permeability(Real(phi))) / (o.viscosity * phi);
+                r = o.sample.density * (1 - phi) * double(params.permeability(Real(phi))) / (o.viscosity * phi * phi);
             } else {
                 r = o.sample.density /
                     double(Drag::beta_per_solid(por.phi[c], por.d_p[c], Real(0), prm.density, prm.viscosity));

@@ -20,7 +20,8 @@
 ///
 /// (drag and buoyancy together: the fluid's whole force on the solid of a cell, -grad p +
 /// phi rho_f g per unit volume of mixture, shared by solid volume). There is no fluid
-/// velocity to advance and no momentum: the step is unconditionally stable.
+/// velocity to advance and no momentum: the pressure step is unconditionally stable; the
+/// coupling's explicit exchange is limited by the particles' response time (D-6).
 ///
 /// Layout: pressure, porosity, the mean particle velocity and K live at cell centres in
 /// fluid_grid::field_index layout (one ghost layer), like navier_stokes's.
@@ -235,8 +236,9 @@ struct darcy_precheck {
 
 /// The Darcy force on particle i (D-5): V / (1 - phi) (phi rho_f g - grad p) with the porosity
 /// of its cell (capped at max_porosity), or without pressure_force only the drag part,
-/// V phi / (1 - phi) (rho_f g - grad p) (the whole less the buoyancy -V grad p). No response
-/// time limits the step (the force does not depend on the particle's own velocity).
+/// V phi / (1 - phi) (rho_f g - grad p) (the whole less the buoyancy -V grad p). Its response
+/// time (D-6): the drag part is C (v_f - v_s) with C = V phi^2 / (K (1 - phi)) (Darcy's law),
+/// so m / C = m K (1 - phi) / (V phi^2), which the coupling's explicit step must not exceed.
 template <class Real>
 struct darcy_particle_force {
     darcy_view<Real> f;
@@ -260,7 +262,7 @@ struct darcy_particle_force {
         vec3<Real> force = seepage * (V * phi / (Real(1) - phi));
         if (pressure_force) force -= (f.g * f.rho - seepage) * V;
         out[i] = force;
-        response[i] = Real(1e30);
+        response[i] = p.mass[i] * f.K[c] * (Real(1) - phi) / (V * phi * phi);
     }
 };
 
@@ -443,8 +445,8 @@ public:
                          params_.fluid.poisson.tolerance, "); raise darcy_params::fluid.poisson.max_iterations");
     }
 
-    /// The coupling's hooks (fluid_coupling::step): the Darcy force (D-5) on each particle;
-    /// no response time limits the step (1e30). `Drag` is not used.
+    /// The coupling's hooks (fluid_coupling::step): the Darcy force (D-5) on each particle and
+    /// its response time (D-6). `Drag` is not used.
     template <class Drag>
     void particle_forces(const particle_view<Real>& p, const porosity_view<Real>&, vec3<Real>* out, Real* response,
                          bool pressure_force)
