@@ -1,15 +1,17 @@
 #pragma once
-// Scratch files for the output tests (test_io, test_vti): a temporary folder removed when the
-// test leaves, and a file's bytes.
+// Scratch files for the output tests (test_io, test_vti, test_fluid_restart): a temporary
+// folder removed when the test leaves, a file's bytes read and written, and bytewise equality.
 #include <catch2/catch.hpp>
 
 #include <unistd.h>
 
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <string>
 #include <system_error>
+#include <vector>
 
 namespace sphere_test {
 
@@ -38,6 +40,27 @@ inline std::string read_bytes(const std::string& path)
 {
     std::ifstream in(path, std::ios::binary);
     return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+/// Writes `bytes` to the file at `path`, replacing it.
+inline void write_bytes(const std::string& path, const std::string& bytes)
+{
+    std::ofstream out(path, std::ios::binary | std::ios::trunc);
+    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+}
+
+/// Bytewise equality of two values without padding (scalars, vec3, vec4).
+template <class T>
+bool same_bits(const T& a, const T& b)
+{
+    return std::memcmp(&a, &b, sizeof(T)) == 0;
+}
+
+/// Bytewise equality of two arrays of padding-free values.
+template <class T>
+bool same_bits(const std::vector<T>& a, const std::vector<T>& b)
+{
+    return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
 }
 
 } // namespace sphere_test

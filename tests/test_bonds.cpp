@@ -311,11 +311,7 @@ struct bonded_sample {
     }
 };
 
-template <class Real>
-bool same_bits(const std::vector<Real>& a, const std::vector<Real>& b)
-{
-    return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(Real)) == 0;
-}
+using sphere_test::same_bits;
 
 template <class Real>
 void require_same_bonds(const sphere::bond_table<Real>& a, const sphere::bond_table<Real>& b)

@@ -104,6 +104,9 @@ TEMPLATE_TEST_CASE("Darcy parameters are validated", "[darcy]", float, double)
                       Catch::Contains("darcy: nz = 2 cells; a prescribed-pressure end needs nz >= 3"));
     model ok(g, prm);
     CHECK_THROWS_WITH(ok.step(Real(0)), Catch::Contains("darcy: time step dt = 0 s"));
+    sphere::porosity_estimator<Real, sphere::host> other(sphere::fluid_grid<Real>::make(column_box<Real>(1, 1, 1), 2, 2, 5));
+    CHECK_THROWS_WITH(ok.set_porosity(other.view()),
+                      Catch::Contains("darcy: the porosity grid has 5 cells along axis 2, the fluid grid 4"));
 }
 
 TEMPLATE_TEST_CASE("Darcy: a column of fluid at rest is hydrostatic", "[darcy]", float, double)

@@ -14,6 +14,7 @@
 // - a truncated or corrupt fluid section is refused.
 #include <catch2/catch.hpp>
 
+#include "checkpoint_bytes.hpp"
 #include "temp_folder.hpp"
 
 #include <sphere/dem.cuh>
@@ -32,28 +33,16 @@
 
 namespace {
 
+using sphere_test::as_version;
 using sphere_test::read_bytes;
+using sphere_test::same_bits;
 using sphere_test::temp_folder;
+using sphere_test::write_bytes;
 
 template <class Real>
 using sim_t = sphere::simulation<Real, sphere::host>;
 template <class Real, class Poisson = sphere::mg_poisson<Real, sphere::host>>
 using coupling_t = sphere::fluid_coupling<Real, sphere::host, sphere::drag::gidaspow, Poisson>;
-
-void write_bytes(const std::string& path, const std::string& bytes)
-{
-    std::ofstream out(path, std::ios::binary | std::ios::trunc);
-    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-}
-
-/// Bytewise equality of two arrays of padding-free values.
-template <class T>
-bool same_bits(const std::vector<T>& a, const std::vector<T>& b)
-{
-    return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
-}
-
-bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 
 /// 240 particles (6 x 5 x 8, radii 0.40-0.49 mm, 2600 kg/m^3) settling from the upper half of a
 /// 20 x 20 x 40 mm column with periodic sides in water-like fluid of 0.01 Pa s; 4 x 4 x 8 fluid
@@ -238,20 +227,6 @@ void check_coupled_restart(Make make, unsigned iterations_above)
     const observed<Real> without = observe(again, forgetful);
     CHECK_FALSE(same_bits(without.particles.x, expected.particles.x));
     CHECK_FALSE(same_bits(without.p, expected.p));
-}
-
-/// The bytes of a checkpoint as another format version `version`, without `count` payload
-/// bytes from `at` (header and checksum rewritten).
-std::string as_version(std::string b, std::uint32_t version, std::size_t at, std::size_t count)
-{
-    b.erase(at, count);
-    b.resize(b.size() - 8);
-    b[8] = static_cast<char>(version);
-    const std::uint64_t payload = b.size() - 24;
-    for (int k = 0; k < 8; ++k) b[16 + k] = static_cast<char>((payload >> (8 * k)) & 0xffu);
-    const std::uint64_t sum = sphere::detail::fnv1a64(b.data(), b.size());
-    for (int k = 0; k < 8; ++k) b += static_cast<char>((sum >> (8 * k)) & 0xffu);
-    return b;
 }
 
 } // namespace

@@ -7,6 +7,7 @@
 //     field exactly (parsed here independently; tests/vtk_read.py reads them with VTK itself).
 #include <catch2/catch.hpp>
 
+#include "checkpoint_bytes.hpp"
 #include "temp_folder.hpp"
 
 #include "support.hpp"
@@ -44,26 +45,9 @@ using sphere::vec3;
 using sphere::vec4;
 
 using sphere_test::read_bytes;
+using sphere_test::same_bits;
 using sphere_test::temp_folder;
-
-void write_bytes(const std::string& path, const std::string& bytes)
-{
-    std::ofstream out(path, std::ios::binary | std::ios::trunc);
-    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-}
-
-/// Bytewise equality of two arrays of padding-free values (vec3, vec4, scalars).
-template <class T>
-bool same_bits(const std::vector<T>& a, const std::vector<T>& b)
-{
-    return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
-}
-
-template <class T>
-bool same_bits(const T& a, const T& b)
-{
-    return std::memcmp(&a, &b, sizeof(T)) == 0;
-}
+using sphere_test::write_bytes;
 
 /// Every evolving field of two states compared bytewise (wall faces field by field: the
 /// struct has padding).
@@ -381,24 +365,13 @@ TEMPLATE_TEST_CASE("format version 6, 5 and 4 checkpoints, from before the fluid
     host_sim<Real> sim = eventful_run<Real>(100);
     const std::string v7 = dir / "v7.ck", v6 = dir / "v6.ck", v5 = dir / "v5.ck", v4 = dir / "v4.ck";
     sphere::write_checkpoint(v7, sim);
-    // The bytes of `b` as format `version`, without `count` payload bytes from `at`.
-    const auto older = [](std::string b, std::uint32_t version, std::size_t at, std::size_t count) {
-        b.erase(at, count);
-        b.resize(b.size() - 8);
-        b[8] = static_cast<char>(version);
-        const std::uint64_t payload = b.size() - 24;
-        for (int k = 0; k < 8; ++k) b[16 + k] = static_cast<char>((payload >> (8 * k)) & 0xffu);
-        const std::uint64_t sum = sphere::detail::fnv1a64(b.data(), b.size());
-        for (int k = 0; k < 8; ++k) b += static_cast<char>((sum >> (8 * k)) & 0xffu);
-        return b;
-    };
     const std::string b7 = read_bytes(v7);
-    const std::string b6 = older(b7, 6, b7.size() - 8 - 4, 4);
+    const std::string b6 = sphere_test::as_version(b7, 6, b7.size() - 8 - 4, 4);
     write_bytes(v6, b6);
-    const std::string b5 = older(b6, 5, b6.size() - 8 - 144, 144);
+    const std::string b5 = sphere_test::as_version(b6, 5, b6.size() - 8 - 144, 144);
     write_bytes(v5, b5);
     const std::string name = sphere::contact::linear<>::name(), layout = sphere::contact::linear<>::history_layout;
-    write_bytes(v4, older(b5, 4, 24, 16 + name.size() + layout.size()));
+    write_bytes(v4, sphere_test::as_version(b5, 4, 24, 16 + name.size() + layout.size()));
     const sphere::checkpoint_data<Real> now = sphere::read_checkpoint<Real>(v7);
     CHECK(now.version == 7);
     CHECK_FALSE(now.fluid.has_value());

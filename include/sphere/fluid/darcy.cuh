@@ -340,10 +340,7 @@ public:
     /// grid). The next step throws when a cell's porosity is not in (0, 1].
     void set_porosity(const porosity_view<Real>& in)
     {
-        for (int a = 0; a < 3; ++a)
-            if (in.grid.n[a] != grid_.n[a])
-                detail::fail("darcy: the porosity grid has ", in.grid.n[a], " cells along axis ", a,
-                             ", the fluid grid ", grid_.n[a]);
+        base::check_porosity_grid(in.grid, grid_, "darcy");
         for_each_index(Policy{}, grid_.cell_count(), detail::darcy_take_porosity<Real>{view(), in, params_});
         transform_reduce_into(context_, grid_.cell_count(), detail::darcy_cell_porosity<Real>{view()}, Real(1),
                               min_op{}, &report_.data()->lowest_porosity);

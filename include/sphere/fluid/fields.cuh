@@ -135,6 +135,16 @@ protected:
         return host_report_;
     }
 
+    /// Throws unless a porosity estimate's grid has the model's cell counts (`who` begins the
+    /// message: "fluid" or "darcy").
+    static void check_porosity_grid(const fluid_grid<Real>& porosity, const fluid_grid<Real>& model, const char* who)
+    {
+        for (int a = 0; a < 3; ++a)
+            if (porosity.n[a] != model.n[a])
+                fail(who, ": the porosity grid has ", porosity.n[a], " cells along axis ", a, ", the fluid grid ",
+                     model.n[a]);
+    }
+
     /// The snapshot entries of this part: the time, the step count and the last solve.
     void add_step_state(fluid_snapshot<Real>& s) const
     {
