@@ -356,6 +356,12 @@ TEMPLATE_TEST_CASE("Hertz: a checkpoint names its law and restarts bit for bit",
         CHECK(a.v[i].z == b.v[i].z);
         CHECK(a.omega[i].y == b.omega[i].y);
     }
+    // The header names the law (what a program that runs several laws picks the type by).
+    const sphere::checkpoint_header header = sphere::read_checkpoint_header(path);
+    CHECK(header.version == sphere::checkpoint_format_version);
+    CHECK(header.written_precision == sizeof(Real));
+    CHECK(header.law == hertz::name());
+    CHECK(header.history_layout == std::string(hertz::history_layout));
     // The law's parameters come back by name; a reader with another law refuses the file.
     const auto back = sphere::read_checkpoint<Real, hertz>(path);
     CHECK(back.config.contact.youngs_modulus == s.contact.youngs_modulus);

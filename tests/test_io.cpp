@@ -224,6 +224,8 @@ TEMPLATE_TEST_CASE("checkpoints convert between float and double", "[io][checkpo
 
     const sphere::checkpoint_data<Other> c = sphere::read_checkpoint<Other>(path);
     CHECK(c.written_precision == sizeof(Real));
+    CHECK(sphere::read_checkpoint_header(path).written_precision == sizeof(Real));
+    CHECK(sphere::read_checkpoint_header(path).law == sphere::contact::linear<>::name());
     // Every value is the writer's value converted with static_cast (double on disk holds a
     // float exactly and rounds to float as a direct cast does).
     const sphere::simulation_state<Real> s = original.state();
@@ -485,6 +487,9 @@ TEMPLATE_TEST_CASE("broken checkpoints raise the documented errors", "[io][check
         write_bytes(bad, b);
         REQUIRE_THROWS_WITH(sphere::read_checkpoint<Real>(bad),
                             Catch::StartsWith(where + "corrupt: checksum mismatch (stored 0x"));
+        // The header alone is read only after the same checks of the whole file.
+        REQUIRE_THROWS_WITH(sphere::read_checkpoint_header(bad),
+                            Catch::StartsWith(where + "corrupt: checksum mismatch (stored 0x"));
     }
     SECTION("a flipped byte in the checksum")
     {
@@ -498,6 +503,9 @@ TEMPLATE_TEST_CASE("broken checkpoints raise the documented errors", "[io][check
         for (const std::size_t cut : {size - 1, size / 2, std::size_t(40)}) {
             write_bytes(bad, bytes.substr(0, cut));
             REQUIRE_THROWS_WITH(sphere::read_checkpoint<Real>(bad),
+                                where + "truncated: the file has " + std::to_string(cut) +
+                                    " bytes, a complete checkpoint has " + std::to_string(size));
+            REQUIRE_THROWS_WITH(sphere::read_checkpoint_header(bad),
                                 where + "truncated: the file has " + std::to_string(cut) +
                                     " bytes, a complete checkpoint has " + std::to_string(size));
         }

@@ -460,6 +460,84 @@ std::string encode_checkpoint(const settings<Real, typename Law::template params
     return e.bytes;
 }
 
+/// What a checkpoint says before its settings: the format version, the writer's precision and
+/// (from version 5 on; empty before) the contact law's name and history layout.
+struct checkpoint_header {
+    std::uint32_t version = 0;           ///< the file's format version
+    std::uint32_t written_precision = 0; ///< sizeof the writer's Real: 4 (float) or 8 (double)
+    std::string law;                     ///< Law::name() of the writer's contact law
+    std::string history_layout;          ///< Law::history_layout of the writer's contact law
+};
+
+namespace detail {
+
+/// Checks the bytes of a checkpoint as far as its contact law's name: magic, a format version
+/// this build reads (4 to checkpoint_format_version), size, checksum and precision. Fills
+/// `header` and returns a decoder at the settings. Throws sphere::error naming `path` and what
+/// is wrong.
+inline checkpoint_decoder open_checkpoint(const std::string& bytes, const std::string& path, checkpoint_header& header)
+{
+    constexpr std::size_t head_bytes = checkpoint_header_bytes, tail = checkpoint_checksum_bytes;
+    const std::size_t size = bytes.size();
+    const std::size_t magic_seen = size < 8 ? size : 8;
+    if (bytes.compare(0, magic_seen, checkpoint_magic, magic_seen) != 0)
+        fail("checkpoint '", path, "': not a sphere checkpoint: the file does not start with \"", checkpoint_magic,
+             "\"");
+    if (size < head_bytes + tail)
+        fail("checkpoint '", path, "': truncated: the file has ", size, " bytes, fewer than the ", head_bytes + tail,
+             " of a header and checksum");
+    checkpoint_decoder head(bytes, 8, head_bytes, path);
+    const std::uint32_t version = head.u32("the format version");
+    if (version < 4 || version > checkpoint_format_version)
+        fail("checkpoint '", path, "': format version ", version, ", but this build reads versions ",
+             checkpoint_format_version, ", 6 and 5, and 4 for the linear contact law");
+    const std::uint32_t precision = head.u32("the writer's precision");
+    const std::uint64_t payload = head.u64("the payload size");
+    if (payload > std::numeric_limits<std::uint64_t>::max() - head_bytes - tail)
+        fail("checkpoint '", path, "': corrupt: the header gives an impossible payload size of ", payload, " bytes");
+    const std::uint64_t expected = head_bytes + payload + tail;
+    if (size < expected)
+        fail("checkpoint '", path, "': truncated: the file has ", size, " bytes, a complete checkpoint has ", expected);
+    if (size > expected)
+        fail("checkpoint '", path, "': corrupt: the file has ", size, " bytes, a complete checkpoint has ", expected,
+             " (trailing data)");
+    std::uint64_t stored = 0;
+    for (int k = 0; k < 8; ++k)
+        stored |= std::uint64_t(static_cast<unsigned char>(bytes[size - tail + k])) << (8 * k);
+    const std::uint64_t computed = fnv1a64(bytes.data(), size - tail);
+    if (stored != computed) {
+        std::ostringstream hex;
+        hex << std::hex << "stored 0x" << stored << ", computed 0x" << computed;
+        fail("checkpoint '", path, "': corrupt: checksum mismatch (", hex.str(), ")");
+    }
+    checkpoint_decoder d(bytes, head_bytes, size - tail, path);
+    if (precision != 4 && precision != 8)
+        d.inconsistent("the writer's precision is ", precision, " bytes, neither 4 (float) nor 8 (double)");
+    header.version = version;
+    header.written_precision = precision;
+    if (version >= 5) {
+        header.law = d.text("the contact law's name", 4096);
+        header.history_layout = d.text("the contact history's layout", 4096);
+    }
+    return d;
+}
+
+/// The whole file at `path`; throws sphere::error `checkpoint '<path>': ...` when it cannot be
+/// opened or read.
+inline std::string checkpoint_bytes(const std::string& path)
+{
+    std::ifstream in(path, std::ios::binary);
+    if (!in) {
+        const int code = errno;
+        fail("checkpoint '", path, "': cannot open: ", std::strerror(code));
+    }
+    std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    if (in.bad()) fail("checkpoint '", path, "': cannot read the file");
+    return bytes;
+}
+
+} // namespace detail
+
 /// Decodes the bytes of a checkpoint into the precision Real; `path` names the file in
 /// errors. Throws sphere::error (message `checkpoint '<path>': ...`, see docs/io.md) when the
 /// bytes are not a checkpoint, have another format version, are truncated or longer than the
@@ -468,60 +546,23 @@ template <class Real, class Law = contact::linear<>>
 checkpoint_data<Real, Law> decode_checkpoint(const std::string& bytes, const std::string& path)
 {
     using detail::checkpoint_decoder;
-    constexpr std::size_t header = detail::checkpoint_header_bytes, tail = detail::checkpoint_checksum_bytes;
-    const std::size_t size = bytes.size();
-    const std::size_t magic_seen = size < 8 ? size : 8;
-    if (bytes.compare(0, magic_seen, checkpoint_magic, magic_seen) != 0)
-        detail::fail("checkpoint '", path, "': not a sphere checkpoint: the file does not start with \"",
-                     checkpoint_magic, "\"");
-    if (size < header + tail)
-        detail::fail("checkpoint '", path, "': truncated: the file has ", size, " bytes, fewer than the ",
-                     header + tail, " of a header and checksum");
-    checkpoint_decoder head(bytes, 8, header, path);
-    const std::uint32_t version = head.u32("the format version");
     using params = typename Law::template params<Real>;
     constexpr bool linear_params = std::is_same_v<params, contact_params<Real>>;
-    if (version != checkpoint_format_version && version != 6 && version != 5 && !(version == 4 && linear_params))
-        detail::fail("checkpoint '", path, "': format version ", version, ", but this build reads versions ",
-                     checkpoint_format_version, ", 6 and 5", version == 4 ? ", and 4 only for the linear contact law, "
-                                                                       "which version 4 describes"
-                                                                     : ", and 4 for the linear contact law");
-    const std::uint32_t precision = head.u32("the writer's precision");
-    const std::uint64_t payload = head.u64("the payload size");
-    if (payload > std::numeric_limits<std::uint64_t>::max() - header - tail)
-        detail::fail("checkpoint '", path, "': corrupt: the header gives an impossible payload size of ", payload,
-                     " bytes");
-    const std::uint64_t expected = header + payload + tail;
-    if (size < expected)
-        detail::fail("checkpoint '", path, "': truncated: the file has ", size, " bytes, a complete checkpoint has ",
-                     expected);
-    if (size > expected)
-        detail::fail("checkpoint '", path, "': corrupt: the file has ", size, " bytes, a complete checkpoint has ",
-                     expected, " (trailing data)");
-    std::uint64_t stored = 0;
-    for (int k = 0; k < 8; ++k)
-        stored |= std::uint64_t(static_cast<unsigned char>(bytes[size - tail + k])) << (8 * k);
-    const std::uint64_t computed = detail::fnv1a64(bytes.data(), size - tail);
-    if (stored != computed) {
-        std::ostringstream hex;
-        hex << std::hex << "stored 0x" << stored << ", computed 0x" << computed;
-        detail::fail("checkpoint '", path, "': corrupt: checksum mismatch (", hex.str(), ")");
-    }
-    checkpoint_decoder d(bytes, header, size - tail, path);
-    if (precision != 4 && precision != 8)
-        d.inconsistent("the writer's precision is ", precision, " bytes, neither 4 (float) nor 8 (double)");
+    checkpoint_header header;
+    checkpoint_decoder d = detail::open_checkpoint(bytes, path, header);
+    const std::uint32_t version = header.version;
+    if (version == 4 && !linear_params)
+        detail::fail("checkpoint '", path, "': format version 4, but this build reads versions ",
+                     checkpoint_format_version, ", 6 and 5, and 4 only for the linear contact law, which version 4 "
+                     "describes");
+    if (version >= 5 && (header.law != Law::name() || header.history_layout != Law::history_layout))
+        detail::fail("checkpoint '", path, "': written with the contact law ", header.law, " (history: ",
+                     header.history_layout, "), but the reader uses ", Law::name(), " (history: ", Law::history_layout,
+                     "); restart it with the same law");
 
     checkpoint_data<Real, Law> c;
-    c.written_precision = precision;
+    c.written_precision = header.written_precision;
     c.version = version;
-    if (version >= 5) {
-        const std::string law = d.text("the contact law's name", 4096);
-        const std::string history = d.text("the contact history's layout", 4096);
-        if (law != Law::name() || history != Law::history_layout)
-            detail::fail("checkpoint '", path, "': written with the contact law ", law, " (history: ", history,
-                         "), but the reader uses ", Law::name(), " (history: ", Law::history_layout,
-                         "); restart it with the same law");
-    }
     settings<Real, params>& s = c.config;
     s.box.lo = d.v3<Real>("settings.box.lo");
     s.box.hi = d.v3<Real>("settings.box.hi");
@@ -687,14 +728,18 @@ void write_checkpoint(const std::string& path, const Sim& sim, Coupling& couplin
 template <class Real, class Law = contact::linear<>>
 checkpoint_data<Real, Law> read_checkpoint(const std::string& path)
 {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) {
-        const int code = errno;
-        detail::fail("checkpoint '", path, "': cannot open: ", std::strerror(code));
-    }
-    std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    if (in.bad()) detail::fail("checkpoint '", path, "': cannot read the file");
-    return decode_checkpoint<Real, Law>(bytes, path);
+    return decode_checkpoint<Real, Law>(detail::checkpoint_bytes(path), path);
+}
+
+/// The header of the checkpoint at `path` (format version, writer's precision, contact law),
+/// after the checks of the whole file that read_checkpoint makes before the settings: a
+/// program that runs checkpoints of several laws reads it to pick the simulation type. Throws
+/// sphere::error `checkpoint '<path>': ...` as read_checkpoint does.
+inline checkpoint_header read_checkpoint_header(const std::string& path)
+{
+    checkpoint_header header;
+    detail::open_checkpoint(detail::checkpoint_bytes(path), path, header);
+    return header;
 }
 
 namespace detail {

@@ -1,0 +1,251 @@
+// sphere: runs the simulation a checkpoint describes until a total simulated time, writing
+// numbered checkpoints and VTK frames at an interval of simulated time, a status file and a
+// progress line; resumes from its last output after a crash (docs/program.md).
+#include <sphere/dem.cuh>
+#include <sphere/io.cuh>
+
+#include <CLI/CLI.hpp>
+
+#include "describe.hpp"
+#include "run_plan.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <exception>
+#include <filesystem>
+#include <iostream>
+#include <limits>
+#include <optional>
+#include <string>
+
+#ifndef SPHERE_PROGRAM_VERSION
+#define SPHERE_PROGRAM_VERSION "unknown"
+#endif
+
+namespace {
+
+struct options {
+    std::string input;
+    std::string out = "output";
+    std::string backend = "host";
+    std::string precision = "file";
+    std::string integrator = "euler";
+    double total = std::numeric_limits<double>::quiet_NaN();
+    double interval = std::numeric_limits<double>::quiet_NaN();
+    bool dry = false, quiet = false, fresh = false, vtk = true;
+};
+
+namespace fs = std::filesystem;
+
+/// The progress line on stderr: a bar, the simulated time, the output number and the wall
+/// time left at the speed of this process so far; at most once a second.
+class progress_line {
+public:
+    progress_line(bool quiet, const program::run_plan& plan, std::size_t from)
+        : quiet_(quiet), plan_(plan), from_(from), start_(clock::now()), shown_(start_)
+    {}
+
+    void show(std::size_t step, double time, std::size_t output, bool force)
+    {
+        const auto now = clock::now();
+        if (quiet_ || (!force && now - shown_ < std::chrono::seconds(1))) return;
+        shown_ = now;
+        const std::size_t all = plan_.last - plan_.first, done = step - plan_.first;
+        const double fraction = all ? double(done) / double(all) : 1.0;
+        const double elapsed = std::chrono::duration<double>(now - start_).count();
+        const double rate = step > from_ ? elapsed / double(step - from_) : 0; // wall seconds per step
+        const int width = 30, filled = static_cast<int>(fraction * width);
+        std::fprintf(stderr, "\r[%.*s%.*s] %5.1f%%  t = %.6g s  output %zu/%zu  %.0f s", filled,
+                     "##############################", width - filled, "                              ",
+                     100 * fraction, time, output, plan_.outputs() - 1, elapsed);
+        if (step > from_) std::fprintf(stderr, ", ~%.0f s left   ", rate * double(plan_.last - step));
+    }
+
+    void end() const
+    {
+        if (!quiet_) std::fprintf(stderr, "\n");
+    }
+
+private:
+    using clock = std::chrono::steady_clock;
+    bool quiet_;
+    program::run_plan plan_;
+    std::size_t from_;
+    clock::time_point start_, shown_;
+};
+
+/// Removes the files of an earlier run of `files.name` from the output folder (--fresh).
+void remove_earlier_run(const program::run_files& files)
+{
+    std::error_code ec;
+    for (const auto& entry : fs::directory_iterator(files.folder, ec)) {
+        const std::string name = entry.path().filename().string();
+        const bool numbered = name.rfind(files.name + ".output", 0) == 0;
+        if (numbered || name == files.name + ".pvd" || name == files.name + ".status.dat") fs::remove(entry.path());
+    }
+}
+
+/// Runs the checkpoint with the simulation type Sim (its precision, law and integrator).
+template <class Sim>
+int run(const options& o, const std::string& run_name)
+{
+    using Real = typename Sim::real_type;
+    using Law = typename Sim::law_type;
+    const sphere::checkpoint_data<Real, Law> input = sphere::read_checkpoint<Real, Law>(o.input);
+    if (input.fluid)
+        sphere::detail::fail("checkpoint '", o.input, "' holds a pore-fluid section (model ", input.fluid->model,
+                             "); the sphere program runs DEM checkpoints only: continue a coupled run from C++ "
+                             "(sphere::restart(path, coupling))");
+    const double dt = double(input.config.dt);
+    const program::run_files files{o.out, fs::path(o.input).stem().string()};
+    const double t0 = double(input.state.steps) * dt;
+    if (!o.dry && !std::isfinite(o.total)) sphere::detail::fail("--total: the simulated time to run to (s) is required");
+    const double total = std::isfinite(o.total) ? o.total : t0; // --dry without it: the settings and an empty run
+    const double interval = !std::isnan(o.interval) ? o.interval : total > t0 ? (total - t0) / 10 : dt;
+    const program::run_plan plan = program::run_plan::make(input.state.steps, dt, total, interval);
+    if (o.dry) {
+        program::describe(o.input, input, run_name, plan, files);
+        if (!std::isfinite(o.total)) std::printf("(no --total given: a run needs one)\n");
+        return 0;
+    }
+
+    program::run_status status;
+    status.identity = {{"input", o.input},
+                       {"input_checksum", program::file_checksum(o.input)},
+                       {"run", run_name},
+                       {"first_step", std::to_string(plan.first)},
+                       {"last_step", std::to_string(plan.last)},
+                       {"output_every", std::to_string(plan.every)}};
+    std::error_code ec;
+    fs::create_directories(o.out, ec);
+    if (ec) sphere::detail::fail("cannot create the output folder '", o.out, "': ", ec.message());
+    if (o.fresh) remove_earlier_run(files);
+
+    std::optional<Sim> sim;
+    std::size_t output = 0;
+    sphere::pvd_collection frames(files.collection());
+    if (fs::exists(files.status())) {
+        const program::run_status earlier = program::run_status::read(files.status());
+        const std::string difference = status.difference(earlier);
+        if (!difference.empty())
+            sphere::detail::fail("the output folder '", o.out, "' holds another run of '", files.name, "' (",
+                                 difference, "): give --fresh to replace it, or another --out");
+        output = earlier.last_output;
+        if (output >= plan.outputs())
+            sphere::detail::fail("status file '", files.status(), "': last output ", output, ", but the run has ",
+                                 plan.outputs());
+        sim.emplace(sphere::restart<Sim>(files.checkpoint(output)));
+        if (sim->steps() != plan.step_of(output))
+            sphere::detail::fail("'", files.checkpoint(output), "' is at step ", sim->steps(), ", output ", output,
+                                 " of this run is at step ", plan.step_of(output));
+        if (o.vtk && fs::exists(files.collection())) {
+            frames = sphere::pvd_collection::load(files.collection());
+            frames.drop_from(sim->time() + dt / 2);
+        }
+        if (!o.quiet) std::printf("resuming from output %zu (t = %.9g s)\n", output, sim->time());
+    } else {
+        sim.emplace(sphere::detail::restart_from<Sim>(input));
+    }
+
+    const auto write_output = [&](std::size_t k) {
+        sphere::write_checkpoint(files.checkpoint(k), *sim);
+        if (o.vtk) {
+            sphere::write_vtu(files.folder + "/" + files.frame(k), *sim);
+            frames.add(sim->time(), files.frame(k));
+        }
+        status.time = sim->time();
+        status.percent = plan.last > plan.first
+                             ? 100.0 * double(sim->steps() - plan.first) / double(plan.last - plan.first)
+                             : 100.0;
+        status.last_output = k;
+        status.write(files.status());
+    };
+    if (!fs::exists(files.status())) write_output(0);
+
+    progress_line bar(o.quiet, plan, sim->steps());
+    bar.show(sim->steps(), sim->time(), output, true);
+    for (std::size_t k = output + 1; k < plan.outputs(); ++k) {
+        while (sim->steps() < plan.step_of(k)) {
+            sim->run(std::min<std::size_t>(plan.step_of(k) - sim->steps(), 100));
+            bar.show(sim->steps(), sim->time(), k - 1, false);
+        }
+        write_output(k);
+        bar.show(sim->steps(), sim->time(), k, k + 1 == plan.outputs());
+    }
+    bar.end();
+    if (!o.quiet)
+        std::printf("t = %.9g s after %zu steps; output in %s/: %s.output00000 to %05zu (.ck%s), %s.status.dat\n",
+                    sim->time(), sim->steps(), o.out.c_str(), files.name.c_str(), plan.outputs() - 1,
+                    o.vtk ? ", .vtu, .pvd" : "", files.name.c_str());
+    return 0;
+}
+
+/// The simulation type for the options and the checkpoint's precision and law; runs it.
+template <class Precision, class Law>
+int run_integrator(const options& o, const std::string& precision)
+{
+    const std::string law = Law::name();
+    if (o.integrator == "verlet")
+        return run<sphere::simulation<Precision, sphere::host, Law, sphere::integrate::velocity_verlet>>(
+            o, law + ", " + precision + ", velocity Verlet, host");
+    return run<sphere::simulation<Precision, sphere::host, Law, sphere::integrate::semi_implicit_euler>>(
+        o, law + ", " + precision + ", semi-implicit Euler, host");
+}
+
+template <class Law>
+int run_precision(const options& o, const sphere::checkpoint_header& header)
+{
+    const std::string p = o.precision == "file" ? (header.written_precision == 4 ? "float" : "double") : o.precision;
+    if (p == "float") return run_integrator<float, Law>(o, p);
+    if (p == "mixed") return run_integrator<sphere::mixed, Law>(o, p);
+    return run_integrator<double, Law>(o, p);
+}
+
+int dispatch(const options& o)
+{
+    if (o.backend == "cuda")
+        sphere::detail::fail("--backend cuda: this sphere program was built for the host backend only");
+    const sphere::checkpoint_header header = sphere::read_checkpoint_header(o.input);
+    using linear = sphere::contact::linear<>;
+    using hertz = sphere::contact::hertz_mindlin<>;
+    if (header.version < 5 || header.law == linear::name()) return run_precision<linear>(o, header);
+    if (header.law == hertz::name()) return run_precision<hertz>(o, header);
+    sphere::detail::fail("checkpoint '", o.input, "': contact law ", header.law, "; the sphere program runs ",
+                         linear::name(), " and ", hertz::name(), " (other laws: restart from C++)");
+}
+
+} // namespace
+
+int main(int argc, char** argv)
+{
+    options o;
+    CLI::App app{"sphere: runs the simulation a checkpoint describes until --total seconds of simulated time, "
+                 "writing numbered checkpoints, VTK frames and a status file into the output folder; run again, "
+                 "it resumes from the last output"};
+    app.set_version_flag("-V,--version", std::string("sphere ") + SPHERE_PROGRAM_VERSION + " (checkpoint format " +
+                                             std::to_string(sphere::checkpoint_format_version) +
+                                             ", backends: host)");
+    app.add_option("input", o.input, "the checkpoint to run (a .ck file)")->required();
+    app.add_option("-o,--out", o.out, "output folder (created)")->capture_default_str();
+    app.add_option("-t,--total", o.total, "simulated time to run to (s), counted from the simulation's start");
+    app.add_option("-i,--interval", o.interval,
+                   "simulated time between outputs (s); default a tenth of the run");
+    app.add_option("--backend", o.backend, "host or cuda")->check(CLI::IsMember({"host", "cuda"}))->capture_default_str();
+    app.add_option("--precision", o.precision, "file (the checkpoint's), float, double or mixed")
+        ->check(CLI::IsMember({"file", "float", "double", "mixed"}))->capture_default_str();
+    app.add_option("--integrator", o.integrator, "euler (semi-implicit) or verlet (velocity Verlet)")
+        ->check(CLI::IsMember({"euler", "verlet"}))->capture_default_str();
+    app.add_flag("-n,--dry", o.dry, "print the settings, the time step and the plan of the run; run nothing");
+    app.add_flag("--fresh", o.fresh, "start from the input, replacing an earlier run's output of it");
+    app.add_flag("!--no-vtk", o.vtk, "write no VTK frames");
+    app.add_flag("-q,--quiet", o.quiet, "no progress line and no summary");
+    CLI11_PARSE(app, argc, argv);
+    try {
+        return dispatch(o);
+    } catch (const std::exception& ex) {
+        if (!o.quiet) std::fprintf(stderr, "\n");
+        std::cerr << ex.what() << '\n';
+        return 1;
+    }
+}
