@@ -3,16 +3,18 @@
 
 Usage: /usr/bin/python3 scripts/plot_series.py SERIES.csv [--out DIR]
 
-The CSV has a header line of `name_unit` columns and rows of numbers. Columns read:
-  required   time_s, kinetic_J, rotational_J, potential_J, elastic_J, dissipated_visc_J,
-             dissipated_fric_J, boundary_work_J, total_J; or, instead, the Terzaghi columns
+The CSV has a header line of `name_unit` columns and rows of numbers: every CSV the project
+writes (the examples' series.csv, collision.csv, fluid_consolidation's terzaghi.csv). Columns:
+  required   time_s
+  energy     time_s, kinetic_J, rotational_J, potential_J, elastic_J, dissipated_visc_J,
+             dissipated_fric_J, boundary_work_J, total_J
   terzaghi   time_s, settlement_m, terzaghi_settlement_m, excess_p_bottom_Pa,
              terzaghi_excess_p_bottom_Pa (fluid_consolidation's terzaghi.csv)
   walls      wall_<face>_position_m, wall_<face>_force_N (face: xlo xhi ylo yhi zlo zhi);
              normal_stress_Pa
   porosity   porosity, void_ratio (derived from porosity when absent)
   shear      shear_strain, shear_stress_Pa, friction_coefficient, dilation_m
-Other columns (wall velocities, side_stress_Pa, axial_strain, ...) are read but not plotted.
+Every other column is drawn against time in series.png.
 
 Figures, written to DIR (default: the CSV's folder), one printed line (the path) each:
   energy.png    energy budget and the balance total_J - total_J[0] against time (when the
@@ -23,6 +25,8 @@ Figures, written to DIR (default: the CSV's folder), one printed line (the path)
                 (when `shear_strain` exists)
   terzaghi.png  settlement and the bottom's excess pore pressure against Terzaghi's (when the
                 Terzaghi columns exist)
+  series.png    one panel per column that none of the figures above shows, against time
+                (when there is such a column)
 Errors (unreadable file, bad header or row, no rows) print one message naming the file to
 stderr and exit with status 2, before any figure is written.
 """
@@ -58,9 +62,8 @@ def read_series(path):
     names = [n.strip() for n in lines[0].split(",")]
     if len(set(names)) != len(names):
         raise SeriesError(f"'{path}' line 1: repeated column name in the header")
-    missing = [c for c in ENERGY_COLUMNS if c not in names]
-    if missing and not all(c in names for c in TERZAGHI_COLUMNS):
-        raise SeriesError(f"'{path}' line 1: header lacks the column(s) {', '.join(missing)}")
+    if "time_s" not in names:
+        raise SeriesError(f"'{path}' line 1: header lacks the column time_s")
     rows = []
     for number, line in enumerate(lines[1:], start=2):
         values = line.split(",")
@@ -191,6 +194,42 @@ def plot_terzaghi(s):
     return fig
 
 
+def shown_elsewhere(s):
+    """The columns that energy.png, walls.png, porosity.png, shear.png and terzaghi.png draw."""
+    shown = {"time_s"}
+    if all(c in s for c in ENERGY_COLUMNS):
+        shown.update(ENERGY_COLUMNS)
+    if all(c in s for c in TERZAGHI_COLUMNS):
+        shown.update(TERZAGHI_COLUMNS)
+    if any(name.startswith("wall_") for name in s):
+        shown.update({f"wall_{f}_{q}" for f in FACES for q in ("position_m", "force_N")})
+        shown.add("normal_stress_Pa")
+    if "porosity" in s:
+        shown.update({"porosity", "void_ratio"})
+    if "shear_strain" in s:
+        shown.update({"shear_strain", "shear_stress_Pa", "friction_coefficient", "dilation_m"})
+    return shown
+
+
+def plot_other(s):
+    """One panel per column that no other figure shows, against time, three panels a row."""
+    shown = shown_elsewhere(s)
+    columns = [c for c in s if c not in shown]
+    rows = (len(columns) + 2) // 3
+    fig, axes = plt.subplots(rows, min(3, len(columns)), sharex=True, squeeze=False,
+                             figsize=(4 * min(3, len(columns)) + 1, 2.6 * rows + 0.8))
+    for k, name in enumerate(columns):
+        ax = axes[k // 3][k % 3]
+        ax.plot(s["time_s"], s[name], lw=1)
+        ax.set_title(name, fontsize="small")
+    for k in range(len(columns), rows * axes.shape[1]):
+        axes[k // 3][k % 3].set_visible(False)
+    for ax in axes[-1]:
+        ax.set_xlabel("time [s]")
+    fig.tight_layout()
+    return fig
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description="Plot a sphere CSV time series as PNG figures.")
     parser.add_argument("csv", help="the CSV time series")
@@ -210,6 +249,8 @@ def main(argv=None):
             figures.append(("porosity.png", plot_porosity))
         if "shear_strain" in s:
             figures.append(("shear.png", plot_shear))
+        if any(c not in shown_elsewhere(s) for c in s):
+            figures.append(("series.png", plot_other))
         try:
             os.makedirs(out, exist_ok=True)
         except OSError as e:

@@ -395,6 +395,15 @@ TEMPLATE_TEST_CASE("a few hundred spheres deposit to rest under gravity", "[pack
     std::vector<sphere::particle<Real>> one{sphere_test::ball<Real>({Real(0.006), Real(0.006), Real(0.015)}, {0, 0, 0}, Real(r0))};
     sphere::simulation<Real> sim(s, one);
     CHECK_THROWS_WITH(sphere::deposit(sim, 1e-12, 50, 10, 0.0), Catch::Contains("still above the threshold"));
+    // The progress callback sees every check: steps 10, 20, ..., the falling particle's energy.
+    std::vector<sphere::deposition_result> seen;
+    CHECK_THROWS(sphere::deposit(sim, 1e-12, 50, 10, 0.0, [&](const sphere::deposition_result& r) { seen.push_back(r); }));
+    REQUIRE(seen.size() == 5);
+    for (std::size_t k = 0; k < seen.size(); ++k) {
+        CHECK(seen[k].steps == 10 * (k + 1));
+        CHECK(seen[k].time == Approx(double(seen[k].steps) * double(sim.dt())).epsilon(1e-9));
+        CHECK(seen[k].kinetic > 0);
+    }
     s.gravity = {0, 0, 0};
     sphere::simulation<Real> weightless(s, one);
     CHECK_THROWS_WITH(sphere::deposit(weightless, 1e-12, 50), Catch::Contains("gravity is zero"));

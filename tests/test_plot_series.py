@@ -145,14 +145,15 @@ def main():
         os.mkdir(folder)
         consolidation(os.path.join(folder, "series.csv"))
         check_figures(script, os.path.join(folder, "series.csv"), folder,
-                      ["energy.png", "walls.png", "porosity.png"])
+                      ["energy.png", "walls.png", "porosity.png", "series.png"])
 
-        # Shear: energy and shear only (no wall columns, no porosity); --out elsewhere.
+        # Shear: energy and shear (no wall columns, no porosity), the normal stress in series.png;
+        # --out elsewhere.
         folder = os.path.join(tmp, "shear")
         os.mkdir(folder)
         out = os.path.join(tmp, "shear_figures", "nested")
         shear(os.path.join(folder, "shear.csv"))
-        check_figures(script, os.path.join(folder, "shear.csv"), out, ["energy.png", "shear.png"],
+        check_figures(script, os.path.join(folder, "shear.csv"), out, ["energy.png", "shear.png", "series.png"],
                       ["--out", out])
         if pngs(folder):
             fail(f"--out given, yet figures were written next to the CSV: {pngs(folder)}")
@@ -162,11 +163,18 @@ def main():
         terzaghi(os.path.join(folder, "terzaghi.csv"))
         check_figures(script, os.path.join(folder, "terzaghi.csv"), folder, ["terzaghi.png"])
 
+        # Any other CSV (the collision example's): every column against time in series.png.
+        folder = os.path.join(tmp, "collision")
+        os.mkdir(folder)
+        write_csv(os.path.join(folder, "collision.csv"), ["time_s", "x1_m", "vz1_m_s", "overlap_m", "normal_force_N"],
+                  [[1e-5 * i, 0.01 * i, -1 + 0.1 * i, max(0, 1e-4 * (i - 3)), 5.0 * i] for i in range(20)])
+        check_figures(script, os.path.join(folder, "collision.csv"), folder, ["series.png"])
+
         # Errors: exit status 2, the file named, no PNG written.
         header = ",".join(ENERGY)
         good = ",".join(["1"] * len(ENERGY))
         cases = [
-            ("missing energy column", ",".join(ENERGY[:-1]) + "\n" + ",".join(["1"] * 8) + "\n", "total_J"),
+            ("missing time column", ",".join(ENERGY[1:]) + "\n" + ",".join(["1"] * 8) + "\n", "time_s"),
             ("ragged row", f"{header}\n{good}\n{good},7\n", "line 3"),
             ("non-numeric value", f"{header}\n{good}\n" + good.replace("1", "abc", 1) + "\n", "line 3"),
             ("no data rows", header + "\n", None),

@@ -1,7 +1,8 @@
 #pragma once
 // Shared by the granular examples (consolidation, uniaxial, triaxial, shear): their common
 // command-line options, a sample deposited under gravity, the output folder (VTK frames, one
-// CSV series, a final checkpoint) and the progress line. docs/examples.md describes them.
+// CSV series, a final checkpoint), the progress lines and a saved sample to start from.
+// docs/examples.md describes them.
 #include <sphere/dem.cuh>
 #include <sphere/io.cuh>
 
@@ -16,6 +17,7 @@
 #include <filesystem>
 #include <functional>
 #include <iostream>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -38,6 +40,7 @@ struct sample_options : example::run_options {
     std::uint64_t seed = 1;       ///< radii and initial positions
     double output_interval = 0.02; ///< simulated time between VTK frames and CSV rows (s)
     double wall_mass = 0.1;       ///< mass of a stress-controlled wall, in units of the total particle mass
+    std::string saved_sample;     ///< a saved sample (checkpoint) to start from instead of depositing one
 };
 
 inline void add_sample_options(CLI::App& app, sample_options& o)
@@ -59,6 +62,9 @@ inline void add_sample_options(CLI::App& app, sample_options& o)
         ->check(CLI::PositiveNumber)->capture_default_str();
     app.add_option("--wall-mass", o.wall_mass, "mass of a stress-controlled wall / total particle mass")
         ->check(CLI::PositiveNumber)->capture_default_str();
+    app.add_option("--sample", o.saved_sample,
+                   "start from this saved sample (a checkpoint: an example's sample.ck or checkpoint.ck) instead of "
+                   "depositing one; its particles, contact parameters and world replace the sample options");
     example::add_run_options(app, o);
 }
 
@@ -138,8 +144,52 @@ granular_sim<Real> deposited_sample(const sample_options& o, bool side_walls, co
             sim.set_wall_position(2 * a + 1, double(fitted.hi[a]));
         }
     const double m = sphere_mass(r, o.density);
-    deposit(sim, 1e-4 * double(o.particles) * m * 9.81 * 2 * r, 2000000, 200);
+    const double rest = 1e-4 * double(o.particles) * m * 9.81 * 2 * r;
+    const auto start = std::chrono::steady_clock::now();
+    auto shown = start;
+    deposit(sim, rest, 2000000, 200, -1, [&](const deposition_result& d) {
+        const auto now = std::chrono::steady_clock::now();
+        if (o.quiet || now - shown < std::chrono::seconds(1)) return;
+        shown = now;
+        std::fprintf(stderr, "\rdeposition: t = %.4f s  kinetic energy %.3e J (at rest below %.3e J)  (%.0f s)   ",
+                     d.time, d.kinetic, rest, std::chrono::duration<double>(now - start).count());
+    });
+    if (!o.quiet && shown != start) std::fprintf(stderr, "\n");
     sim.set_wall_position(5, sample_top(sim.snapshot()));
+    return sim;
+}
+
+/// The sample an example starts from. With --sample, the saved one (a checkpoint written by an
+/// example or the sphere program: its particles, contact parameters, world and wall positions),
+/// with the example's particle-wall parameters `wall` and every wall fixed until the example
+/// sets its controls; it must have side walls exactly when `side_walls` asks for them.
+/// Otherwise deposited_sample(o, side_walls, wall), saved as <o.out>/sample.ck for the next
+/// experiment of a chain (docs/examples.md, *Chained experiments*).
+template <class Real>
+granular_sim<Real> prepared_sample(const sample_options& o, bool side_walls, const sphere::contact_params<Real>& wall)
+{
+    using namespace sphere;
+    if (o.saved_sample.empty()) {
+        granular_sim<Real> sim = deposited_sample<Real>(o, side_walls, wall);
+        std::error_code ec;
+        std::filesystem::create_directories(o.out, ec);
+        if (ec) throw sphere::error("cannot create the output folder '" + o.out + "': " + ec.message());
+        write_checkpoint(o.out + "/sample.ck", sim);
+        return sim;
+    }
+    checkpoint_data<Real> c = read_checkpoint<Real>(o.saved_sample);
+    const bool has_side_walls = !c.config.box.periodic(0) && !c.config.box.periodic(1);
+    const bool periodic_sides = c.config.box.periodic(0) && c.config.box.periodic(1);
+    if (side_walls ? !has_side_walls : !periodic_sides)
+        throw sphere::error("--sample '" + o.saved_sample + "': this example needs a sample " +
+                            (side_walls ? "closed by walls on x and y (deposited by triaxial)"
+                                        : "periodic on x and y (deposited by consolidation, uniaxial or shear)"));
+    c.config.wall = wall;
+    for (wall_control<Real>& w : c.config.walls) w = wall_control<Real>{};
+    c.config.max_initial_overlap = std::numeric_limits<Real>::infinity(); // the state was accepted when it began
+    granular_sim<Real> sim(c.config, c.particles());
+    sim.restore(c.state);
+    std::printf("sample: %zu particles from '%s' at t = %.6f s\n", sim.size(), o.saved_sample.c_str(), sim.time());
     return sim;
 }
 

@@ -22,9 +22,9 @@ int run(const options& o)
 {
     using namespace sphere;
     using Sim = granular::granular_sim<Real>;
-    Sim sim = granular::deposited_sample<Real>(o.sample, false, granular::contact_of<Real>(o.sample));
+    Sim sim = granular::prepared_sample<Real>(o.sample, false, granular::contact_of<Real>(o.sample));
     const double z0 = sim.walls().face[5].position;
-    std::printf("consolidation: %zu particles (%s), deposited in %.3f s; sample top at %.6f m, porosity %.4f\n",
+    std::printf("consolidation: %zu particles (%s), sample at t = %.3f s; sample top at %.6f m, porosity %.4f\n",
                 sim.size(), o.sample.precision.c_str(), sim.time(), z0, bulk_porosity(sim).porosity);
 
     wall_control<Real> top = granular::stress_wall(o.sample, sim, o.stress);

@@ -87,7 +87,7 @@ int run(const options& o)
     constexpr bool darcy = std::is_same_v<typename Coupling::model_type, darcy_flow<Real, host, cg_poisson<Real, host>>>;
     const auto clock_start = std::chrono::steady_clock::now();
 
-    Sim sim = granular::deposited_sample<Real>(o.sample, false, granular::contact_of<Real>(o.sample));
+    Sim sim = granular::prepared_sample<Real>(o.sample, false, granular::contact_of<Real>(o.sample));
     const double deposited = sim.time();
     // The dry preload: the loose deposit compacts under it (most of its plastic strain), so
     // that the load step meets a stiffer, nearly elastic skeleton, Terzaghi's assumption.
@@ -101,7 +101,7 @@ int run(const options& o)
     const double height = z_sample - z_bottom;
     const double d = 2 * o.sample.radius;
     const double g = -double(sim.config().gravity.z);
-    std::printf("fluid_consolidation: %zu particles (%s), deposited in %.3f s, preloaded dry at %.0f Pa for %.3f s; "
+    std::printf("fluid_consolidation: %zu particles (%s), sample at t = %.3f s, preloaded dry at %.0f Pa for %.3f s; "
                 "sample %.4f m high (walls at %.4f and %.4f m), porosity %.4f\n",
                 sim.size(), o.sample.precision.c_str(), deposited, o.preload, o.preload > 0 ? o.preload_time : 0.0,
                 height, z_bottom, z_sample, bulk_porosity(sim).porosity);

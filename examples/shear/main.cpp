@@ -6,6 +6,7 @@
 // shear strain (docs/examples.md). Walls are frictionless, as in sphere's shear().
 #include "../common/granular.hpp"
 
+#include <algorithm>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -36,8 +37,8 @@ int run(const options& o)
     using Sim = granular::granular_sim<Real>;
     contact_params<Real> wall = granular::contact_of<Real>(o.sample);
     wall.mu_s = wall.mu_d = 0;
-    Sim sim = granular::deposited_sample<Real>(o.sample, false, wall);
-    std::printf("shear: %zu particles (%s), deposited in %.3f s; porosity %.4f\n", sim.size(),
+    Sim sim = granular::prepared_sample<Real>(o.sample, false, wall);
+    std::printf("shear: %zu particles (%s), sample at t = %.3f s; porosity %.4f\n", sim.size(),
                 o.sample.precision.c_str(), sim.time(), bulk_porosity(sim).porosity);
     sim.set_wall_control(5, granular::stress_wall(o.sample, sim, o.stress));
     const double area = wall_area(sim.walls(), sim.config().box, 5);
@@ -78,8 +79,11 @@ int run(const options& o)
     // The shear cell: fixed floor and driven top layer, each one largest diameter thick. The
     // strain rate is the velocity over the height between the layers' centres (shear_height),
     // the thickness that shears.
-    const Real thickness = Real(2 * o.sample.radius * (1 + o.sample.spread));
     simulation_state<Real> st = sim.state();
+    Real largest = 0; // a saved sample's largest radius; a deposited one's is the options' nominal largest
+    for (const auto& x : st.particles.x) largest = std::max(largest, x.w);
+    const Real thickness =
+        o.sample.saved_sample.empty() ? Real(2 * o.sample.radius * (1 + o.sample.spread)) : Real(2 * largest);
     particle_snapshot<Real> probe = st.particles;
     const double height = shear_height(probe, make_shear_cell(probe, thickness, vec3<Real>{1, 0, 0}));
     const double velocity = o.strain_rate * height;

@@ -40,8 +40,8 @@ int run(const options& o)
 {
     using namespace sphere;
     using Sim = granular::granular_sim<Real>;
-    Sim sim = granular::deposited_sample<Real>(o.sample, true, granular::frictional_wall_of<Real>(o.sample));
-    std::printf("triaxial: %zu particles (%s), deposited in %.3f s; porosity %.4f\n", sim.size(),
+    Sim sim = granular::prepared_sample<Real>(o.sample, true, granular::frictional_wall_of<Real>(o.sample));
+    std::printf("triaxial: %zu particles (%s), sample at t = %.3f s; porosity %.4f\n", sim.size(),
                 o.sample.precision.c_str(), sim.time(), bulk_porosity(sim).porosity);
     for (int f : {0, 1, 2, 3, 5}) sim.set_wall_control(f, granular::stress_wall(o.sample, sim, o.confining));
 

@@ -21,10 +21,10 @@ int run(const options& o)
 {
     using namespace sphere;
     using Sim = granular::granular_sim<Real>;
-    Sim sim = granular::deposited_sample<Real>(o.sample, false, granular::contact_of<Real>(o.sample));
+    Sim sim = granular::prepared_sample<Real>(o.sample, false, granular::contact_of<Real>(o.sample));
     const double z0 = sim.walls().face[5].position, floor = sim.walls().face[4].position;
     const double height0 = z0 - floor;
-    std::printf("uniaxial: %zu particles (%s), deposited in %.3f s; sample height %.6f m, porosity %.4f\n",
+    std::printf("uniaxial: %zu particles (%s), sample at t = %.3f s; sample height %.6f m, porosity %.4f\n",
                 sim.size(), o.sample.precision.c_str(), sim.time(), height0, bulk_porosity(sim).porosity);
     const double strain_end = o.velocity * o.duration / height0;
     if (!(strain_end < 0.5))

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <numeric>
 #include <vector>
 
@@ -308,11 +309,15 @@ struct deposition_result {
 /// rest are not taken for settled before they have fallen. A useful threshold is a small
 /// fraction (1e-6 to 1e-4) of N m g d, the energy of every particle lifted by one diameter.
 ///
+/// `progress`, when given, is called after every check with the deposition so far (a program
+/// prints a progress line from it).
+///
 /// Throws sphere::error when gravity is zero, on a non-positive or non-finite threshold, and
 /// when the energy is still above the threshold after `max_steps` steps, naming both.
 template <class Sim>
 deposition_result deposit(Sim& sim, double kinetic_threshold, std::size_t max_steps, std::size_t check_every = 100,
-                          double min_time = -1)
+                          double min_time = -1,
+                          const std::function<void(const deposition_result&)>& progress = nullptr)
 {
     const auto& s = sim.config();
     const double g = std::sqrt(double(norm2(s.gravity)));
@@ -334,6 +339,7 @@ deposition_result deposit(Sim& sim, double kinetic_threshold, std::size_t max_st
         out.time = sim.time() - start;
         const auto e = sim.energy();
         out.kinetic = double(e.kinetic) + double(e.rotational);
+        if (progress) progress(out);
         if (out.kinetic < kinetic_threshold && out.time >= min_time) return out;
         if (out.steps >= max_steps && out.time < min_time)
             detail::fail("deposit: max_steps = ", max_steps, " steps (", out.time,
