@@ -1,0 +1,23 @@
+// The extension module sphere._sphere (docs/python.md): the library's error as sphere.Error,
+// the project's version, the precision-independent helpers and a submodule per precision
+// (float.cpp, double.cpp).
+#include "common.hpp"
+
+PYBIND11_MODULE(_sphere, m)
+{
+    namespace py = pybind11;
+    m.doc() = "sphere's C++ library (host backend), bound for the Python package sphere";
+    m.attr("__version__") = SPHERE_VERSION;
+    // std::runtime_error's Python counterpart is RuntimeError; the message is what() ("sphere: ...").
+    py::register_exception<sphere::error>(m, "Error", PyExc_RuntimeError);
+    m.def(
+        "gamma_n_from_restitution",
+        [](double e, double m_eff, double k_n, bool tension) {
+            return sphere::gamma_n_from_restitution(e, m_eff, k_n, tension);
+        },
+        py::arg("restitution"), py::arg("effective_mass"), py::arg("k_n"), py::arg("tension") = false,
+        "Normal viscosity gamma_n (N s/m) that gives a contact of effective mass m_eff (kg) and normal stiffness "
+        "k_n (N/m) the restitution coefficient e (contact/restitution.cuh).");
+    sphere_python::bind_float(m);
+    sphere_python::bind_double(m);
+}
