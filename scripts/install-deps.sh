@@ -15,6 +15,7 @@ packages=(
     cmake make g++
     catch2 libeigen3-dev libcli11-dev libbenchmark-dev
     python3-vtk9 python3-matplotlib python3-numpy
+    libpng-dev python3-pil
     pybind11-dev python3-pybind11 python3-pytest python3-dev python3-pip
 )
 

@@ -1,9 +1,11 @@
 // Instantiates every kernel of the DEM core for sphere::cuda in float, double and mixed
 // precision, with every contact-law and integrator policy (Hertz-Mindlin, capillary
 // cohesion and rolling resistance under it, and two materials in double), so that CI proves the CUDA backend compiles and links, and ptxas
-// reports every kernel's resources (tests/check_ptxas.py).
+// reports every kernel's resources (tests/check_ptxas.py); and the ray tracer's pixel kernel
+// (render/trace.cuh) in float and double.
 // It is built, not run: build machines have no GPU.
 #include <sphere/dem.cuh>
+#include <sphere/render/trace.cuh>
 
 #include <cstdio>
 #include <vector>
@@ -88,6 +90,16 @@ double exercise_step_shapes()
            exercise<P, contact::linear<>, integrate::velocity_verlet>();
 }
 
+/// The ray tracer's pixel kernel on one sphere, in precision Real.
+template <class Real>
+double render_one()
+{
+    sphere::sphere_scene<Real> scene;
+    scene.spheres = {{Real(0), Real(0), Real(0), Real(0.5)}};
+    scene.values = {Real(1)};
+    return double(sphere::render_scene<sphere::cuda>(scene, sphere::camera{}, sphere::render_style{}).bytes[0]);
+}
+
 } // namespace
 
 int main()
@@ -99,6 +111,6 @@ int main()
                                 exercise<double, sphere::contact::capillary<sphere::contact::rolling<>>,
                                          sphere::integrate::velocity_verlet>() +
                                 exercise<double, sphere::contact::materials<>, sphere::integrate::semi_implicit_euler>() +
-                                exercise_step_shapes<sphere::mixed>());
+                                exercise_step_shapes<sphere::mixed>() + render_one<float>() + render_one<double>());
     return 0;
 }
