@@ -149,6 +149,7 @@ int run(const options& o, const bed_file& b)
     s.contact_forces = o.audit; // the scenario reads neither the contact forces nor the dissipation
     s.energy_audit = o.audit;
     s.angular_position = false; // nor the rotation angles
+    s.accumulated_displacement = false; // nor the displacements
 
     const double rss_program = status_bytes("VmRSS"); // the program and the input file, before any particle
     const std::size_t per_tile = b.x.size();

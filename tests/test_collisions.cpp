@@ -742,6 +742,64 @@ TEMPLATE_TEST_CASE("angular position: the time integral of the angular velocity"
     }
 }
 
+TEMPLATE_TEST_CASE("accumulated displacement: the time integral of the velocity, across periodic boundaries",
+                   "[collision][displacement]", float, double, sphere::mixed)
+{
+    using P = TestType;
+    using Real = user_real<P>;
+    // A free sphere falling under gravity while it moves at 0.5 m/s along a periodic x axis
+    // 0.2 m long, and a prescribed one moving at (-0.1, 0.05, 0) m/s with no gravity on it,
+    // for 0.6 s: the accumulated displacement is sum v dt with the velocity each step moved the
+    // particle by, x unwrapped (0.3 m: one and a half box lengths while the position wraps),
+    // z the fall. References: x and the prescribed one exactly v t, z the position's own change
+    // (no wrap on z) and -g t (t + dt) / 2 for semi-implicit Euler (v_k = -g k dt), the Verlet
+    // drift's -g t^2 / 2. Tolerance: the rounding of sums of 12000 terms, 12000 x 6e-8 = 7e-4
+    // relative where they are float: the displacement against the position's change in float
+    // positions (float), against the references in float velocities (float, mixed); 1e-9 in
+    // double.
+    const bool float_sums = std::is_same_v<sphere::coord_t<P>, float>;
+    const double tol = float_sums ? 7e-4 : 1e-9, tol_ref = sphere_test::single_fields<P> ? 7e-4 : 1e-9;
+    const double g = 9.81, dt = 5e-5;
+    const std::size_t steps = 12000;
+    sphere::settings<Real> s = box_settings<Real>();
+    s.box.axis[0] = sphere::boundary::periodic;
+    s.box.lo.z = Real(-3);
+    s.gravity = {0, 0, Real(-g)};
+    s.dt = Real(dt);
+    std::vector<sphere::particle<Real>> ps{ball<Real>({0, 0, 0}, {Real(0.5), 0, 0}),
+                                           ball<Real>({Real(0.05), Real(0.05), Real(0.05)}, {Real(-0.1), Real(0.05), 0})};
+    ps[1].kind = sphere::motion::prescribed;
+    auto check = [&](auto sim, double fall) {
+        const double z0 = double(sim.snapshot().x[0].z);
+        sim.run(steps);
+        const auto snap = sim.snapshot();
+        const double t = double(steps) * double(sim.dt());
+        INFO("x " << double(snap.displacement[0].x) << " m (position " << double(snap.x[0].x) << " m), z "
+                  << double(snap.displacement[0].z) << " m, fall " << fall << " m");
+        CHECK(rel_err(snap.displacement[0].x, 0.5 * t) < tol_ref);
+        CHECK(double(snap.x[0].x) < 0.1); // it wrapped
+        CHECK(snap.displacement[0].y == 0);
+        CHECK(rel_err(snap.displacement[0].z, double(snap.x[0].z) - z0) < tol);
+        CHECK(rel_err(snap.displacement[0].z, fall) < tol_ref);
+        CHECK(rel_err(snap.displacement[1].x, -0.1 * t) < tol_ref);
+        CHECK(rel_err(snap.displacement[1].y, 0.05 * t) < tol_ref);
+        CHECK(snap.displacement[1].z == 0);
+        // Off, the field reads zero and the motion is the same.
+        sphere::settings<Real> off = s;
+        off.accumulated_displacement = false;
+        decltype(sim) lean(off, ps);
+        lean.run(steps);
+        const auto q = lean.snapshot();
+        CHECK(q.x[0].x == snap.x[0].x);
+        CHECK(q.x[0].z == snap.x[0].z);
+        CHECK(q.displacement[0].x == 0);
+        CHECK(q.displacement[0].z == 0);
+    };
+    const double t = double(steps) * dt;
+    SECTION("semi-implicit Euler") { check(test_sim<P>(s, ps), -g * t * (t + dt) / 2); }
+    SECTION("velocity Verlet") { check(test_sim<P, sphere::integrate::velocity_verlet>(s, ps), -g * t * t / 2); }
+}
+
 // ---------------------------------------------------------------------------------------------
 // Mass-scaled damping (damping_convention::mass_scaled): c = gamma m* per contact.
 // ---------------------------------------------------------------------------------------------

@@ -139,6 +139,7 @@ std::vector<std::string> differences(const record<Real>& a, const record<Real>& 
     if (!same_bytes(sa.v_sync, sb.v_sync)) out.push_back("v_sync");
     if (!same_bytes(sa.omega_sync, sb.omega_sync)) out.push_back("omega_sync");
     if (!same_bytes(sa.angpos, sb.angpos)) out.push_back("angpos");
+    if (!same_bytes(sa.displacement, sb.displacement)) out.push_back("displacement");
     if (!same_bytes(sa.force, sb.force)) out.push_back("force");
     if (!same_bytes(sa.torque, sb.torque)) out.push_back("torque");
     if (!same_bytes(sa.mass, sb.mass)) out.push_back("mass");
@@ -325,7 +326,8 @@ TEMPLATE_TEST_CASE("the storage order does not change the physics: reordering on
     SECTION("velocity Verlet") { compare(sphere::integrate::velocity_verlet{}); }
 }
 
-TEMPLATE_TEST_CASE("switching off what a run does not read (audit, contact forces, angular positions) keeps the motion's bits",
+TEMPLATE_TEST_CASE("switching off what a run does not read (audit, contact forces, angular positions, displacements) "
+                   "keeps the motion's bits",
                    "[determinism][memory]", float, double, sphere::mixed)
 {
     using P = TestType;
@@ -339,7 +341,7 @@ TEMPLATE_TEST_CASE("switching off what a run does not read (audit, contact force
         using Integrator = decltype(integrator);
         using sim_type = sphere::simulation<P, sphere::host, sphere::contact::linear<>, Integrator>;
         sphere::settings<Real> lean = setup.first;
-        lean.energy_audit = lean.contact_forces = lean.angular_position = false;
+        lean.energy_audit = lean.contact_forces = lean.angular_position = lean.accumulated_displacement = false;
         sim_type full(setup.first, setup.second), trimmed(lean, setup.second);
         full.run(250);
         trimmed.run(250);
@@ -347,7 +349,7 @@ TEMPLATE_TEST_CASE("switching off what a run does not read (audit, contact force
         require_eventful(a);
         CHECK(full.rebuilds() > 2);
         std::vector<std::string> diff = differences(a, b);
-        const std::vector<std::string> not_kept{"angpos",   "pressure", "e_visc", "e_fric",
+        const std::vector<std::string> not_kept{"angpos",   "displacement", "pressure", "e_visc", "e_fric",
                                                 "p_visc",   "p_fric",   "contact forces", "energy budget"};
         for (const std::string& f : not_kept) diff.erase(std::remove(diff.begin(), diff.end(), f), diff.end());
         INFO("fields that differ: " << Catch::Detail::stringify(diff));
@@ -360,6 +362,10 @@ TEMPLATE_TEST_CASE("switching off what a run does not read (audit, contact force
         for (const auto& w : a.snap.angpos) turned = std::max(turned, double(sphere::norm(w)));
         CHECK(turned > 0.1); // rad
         for (const auto& w : b.snap.angpos) REQUIRE(sphere::norm(w) == Real(0));
+        double moved = 0;
+        for (const auto& d : a.snap.displacement) moved = std::max(moved, double(sphere::norm(d)));
+        CHECK(moved > 1e-3); // m
+        for (const auto& d : b.snap.displacement) REQUIRE(sphere::norm(d) == Real(0));
         CHECK(zero(b.snap.e_visc));
         CHECK(zero(b.snap.pressure));
         CHECK(!zero(a.snap.e_visc));

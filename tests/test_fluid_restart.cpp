@@ -314,7 +314,9 @@ TEMPLATE_TEST_CASE("a navier_stokes on its own restores bit-identically", "[flui
 TEMPLATE_TEST_CASE("checkpoints without a fluid section still load; a coupled restart needs one",
                    "[fluid][restart][checkpoint]", float, double)
 {
-    // Version 6 is version 7 without the fluid section's flag (a u32 at the end of the payload).
+    // Version 7 is version 8 without the accumulated displacement at the end of the payload (a
+    // u32 flag and, with it, the array: a u64 count and n vec3 of f64), version 6 is version 7
+    // without the fluid section's flag (a u32 at the end of its payload).
     using Real = TestType;
     temp_folder dir("sphere_fluid_restart");
     sim_t<Real> sim(column_settings<Real>(), column_particles<Real>());
@@ -323,14 +325,16 @@ TEMPLATE_TEST_CASE("checkpoints without a fluid section still load; a coupled re
     const std::string plain = dir / "plain.ck", v6 = dir / "v6.ck", coupled = dir / "coupled.ck";
     sphere::write_checkpoint(plain, sim);
     sphere::write_checkpoint(coupled, sim, fluid);
-    const std::string b7 = read_bytes(plain);
-    REQUIRE(b7[8] == 7);
+    const std::string b8 = read_bytes(plain);
+    REQUIRE(b8[8] == 8);
+    const std::size_t moved = 4 + (sim.config().accumulated_displacement ? 8 + 24 * sim.size() : 0);
+    const std::string b7 = as_version(b8, 7, b8.size() - 8 - moved, moved);
     write_bytes(v6, as_version(b7, 6, b7.size() - 8 - 4, 4));
 
-    const sphere::checkpoint_data<Real> d7 = sphere::read_checkpoint<Real>(plain), d6 = sphere::read_checkpoint<Real>(v6),
+    const sphere::checkpoint_data<Real> d8 = sphere::read_checkpoint<Real>(plain), d6 = sphere::read_checkpoint<Real>(v6),
                                         dc = sphere::read_checkpoint<Real>(coupled);
-    CHECK(d7.version == 7);
-    CHECK_FALSE(d7.fluid.has_value());
+    CHECK(d8.version == 8);
+    CHECK_FALSE(d8.fluid.has_value());
     CHECK(d6.version == 6);
     CHECK_FALSE(d6.fluid.has_value());
     REQUIRE(dc.fluid.has_value());
@@ -338,7 +342,7 @@ TEMPLATE_TEST_CASE("checkpoints without a fluid section still load; a coupled re
     CHECK(same_bits(d6.state.particles.x, dc.state.particles.x));
     // The coupled file is the plain one with the fluid section after the flag.
     const std::string bc = read_bytes(coupled);
-    CHECK(bc.compare(24, b7.size() - 36, b7, 24, b7.size() - 36) == 0);
+    CHECK(bc.compare(24, b7.size() - 36, b8, 24, b7.size() - 36) == 0);
 
     // Both restart a simulation on its own, to the same state.
     sim_t<Real> from6 = sphere::restart<sim_t<Real>>(v6), from7 = sphere::restart<sim_t<Real>>(plain);
@@ -352,7 +356,7 @@ TEMPLATE_TEST_CASE("checkpoints without a fluid section still load; a coupled re
                           "write_checkpoint(path, sim, coupling)");
     CHECK_THROWS_WITH(sphere::restart<sim_t<Real>>(plain, other),
                       "sphere: checkpoint '" + plain +
-                          "': no fluid section (format version 7, written without a coupling); a coupled run is "
+                          "': no fluid section (format version 8, written without a coupling); a coupled run is "
                           "written by write_checkpoint(path, sim, coupling)");
 
     // A file of the other precision restores a coupling of this one (values converted).
@@ -460,11 +464,15 @@ TEMPLATE_TEST_CASE("a truncated or corrupt fluid section is refused", "[fluid][r
     const std::string plain = dir / "plain.ck", coupled = dir / "coupled.ck", bad = dir / "bad.ck";
     sphere::write_checkpoint(plain, sim);
     sphere::write_checkpoint(coupled, sim, fluid);
-    const std::string b = read_bytes(coupled);
+    // Both as format version 7, without the accumulated displacement that follows the fluid
+    // section in version 8: the fluid section then ends the payload.
+    const std::size_t moved = 4 + (sim.config().accumulated_displacement ? 8 + 24 * sim.size() : 0);
+    const auto as_7 = [&](const std::string& bytes) { return as_version(bytes, 7, bytes.size() - 8 - moved, moved); };
+    const std::string b = as_7(read_bytes(coupled));
     const std::string where = "sphere: checkpoint '" + bad + "': ";
     const std::size_t field = fluid.fluid().grid().field_size();
     // The fluid section begins with its flag, where the plain file's last 4 payload bytes are.
-    const std::size_t flag = read_bytes(plain).size() - 8 - 4;
+    const std::size_t flag = as_7(read_bytes(plain)).size() - 8 - 4;
     REQUIRE(b[flag] == 1);
     const std::string model = "navier_stokes";
     // flag, model, 3 cell counts, the box, the array count, then the first array: its name

@@ -71,6 +71,7 @@ void require_identical(const sphere::simulation_state<Real>& a, const sphere::si
     CHECK(same_bits(p.p_visc, q.p_visc));
     CHECK(same_bits(p.p_fric, q.p_fric));
     CHECK(same_bits(p.kind, q.kind));
+    CHECK(same_bits(p.displacement, q.displacement));
     CHECK(same_bits(a.contacts.offset, b.contacts.offset));
     CHECK(same_bits(a.contacts.partner, b.contacts.partner));
     CHECK(same_bits(a.contacts.history, b.contacts.history));
@@ -351,32 +352,42 @@ TEMPLATE_TEST_CASE("a writer killed while writing leaves the previous checkpoint
     CHECK_FALSE(fs::exists(tmp));
 }
 
-TEMPLATE_TEST_CASE("format version 6, 5 and 4 checkpoints, from before the fluid section, the bonds and the "
-                   "contact-law interface, still load",
+TEMPLATE_TEST_CASE("format version 7, 6, 5 and 4 checkpoints, from before the accumulated displacement, the "
+                   "fluid section, the bonds and the contact-law interface, still load",
                    "[io][checkpoint]", float, double)
 {
+    // Version 7 is version 8 without the accumulated displacement's flag at the end of the
+    // payload (a u32: 0 here, where the run keeps none: an older file restarts without one).
     // Version 6 is version 7 without the fluid section's flag at the end of the payload (a
     // u32; 0 for a simulation on its own), version 5 is version 6 without the bond section at
     // the end of the payload (for no bonds: settings.bond's 6 f64, the bond count and 11 empty
     // arrays, 144 bytes), and version 4 is version 5 without the law's name and history layout
-    // at its start (docs/io.md): files made so from a version 7 one read back to the same
+    // at its start (docs/io.md): files made so from a version 8 one read back to the same
     // settings and state, and restart; a reader with another law's parameters refuses
     // version 4. (tests/test_fluid_restart.cpp: coupled restarts and the fluid section.)
     using Real = TestType;
     temp_folder dir;
-    host_sim<Real> sim = eventful_run<Real>(100);
-    const std::string v7 = dir / "v7.ck", v6 = dir / "v6.ck", v5 = dir / "v5.ck", v4 = dir / "v4.ck";
-    sphere::write_checkpoint(v7, sim);
-    const std::string b7 = read_bytes(v7);
+    sphere::settings<Real> s = eventful_settings<Real>();
+    s.accumulated_displacement = false;
+    host_sim<Real> sim(s, eventful_particles<Real>());
+    sim.run(100);
+    const std::string v8 = dir / "v8.ck", v7 = dir / "v7.ck", v6 = dir / "v6.ck", v5 = dir / "v5.ck",
+                      v4 = dir / "v4.ck";
+    sphere::write_checkpoint(v8, sim);
+    const std::string b8 = read_bytes(v8);
+    const std::string b7 = sphere_test::as_version(b8, 7, b8.size() - 8 - 4, 4);
+    write_bytes(v7, b7);
     const std::string b6 = sphere_test::as_version(b7, 6, b7.size() - 8 - 4, 4);
     write_bytes(v6, b6);
     const std::string b5 = sphere_test::as_version(b6, 5, b6.size() - 8 - 144, 144);
     write_bytes(v5, b5);
     const std::string name = sphere::contact::linear<>::name(), layout = sphere::contact::linear<>::history_layout;
     write_bytes(v4, sphere_test::as_version(b5, 4, 24, 16 + name.size() + layout.size()));
-    const sphere::checkpoint_data<Real> now = sphere::read_checkpoint<Real>(v7);
-    CHECK(now.version == 7);
+    const sphere::checkpoint_data<Real> now = sphere::read_checkpoint<Real>(v8);
+    CHECK(now.version == 8);
     CHECK_FALSE(now.fluid.has_value());
+    CHECK_FALSE(now.config.accumulated_displacement);
+    require_identical(sphere::read_checkpoint<Real>(v7).state, now.state);
     require_identical(sphere::read_checkpoint<Real>(v6).state, now.state);
     require_identical(sphere::read_checkpoint<Real>(v5).state, now.state);
     host_sim<Real> b = sphere::restart<host_sim<Real>>(v5);
@@ -388,16 +399,18 @@ TEMPLATE_TEST_CASE("format version 6, 5 and 4 checkpoints, from before the fluid
     CHECK(old.config.contact.mu_d == now.config.contact.mu_d);
     CHECK(old.config.wall.gamma_t == now.config.wall.gamma_t);
     CHECK(old.config.wall.damping == now.config.wall.damping);
-    host_sim<Real> a = sphere::restart<host_sim<Real>>(v4), c = sphere::restart<host_sim<Real>>(v7),
-                   d = sphere::restart<host_sim<Real>>(v6);
+    host_sim<Real> a = sphere::restart<host_sim<Real>>(v4), c = sphere::restart<host_sim<Real>>(v8),
+                   d = sphere::restart<host_sim<Real>>(v6), e = sphere::restart<host_sim<Real>>(v7);
     a.run(50);
     c.run(50);
     d.run(50);
+    e.run(50);
+    require_identical(e.state(), c.state());
     require_identical(a.state(), c.state());
     require_identical(b.state(), c.state());
     require_identical(d.state(), c.state());
     CHECK_THROWS_WITH((sphere::read_checkpoint<Real, sphere::contact::hertz_mindlin<>>(v4)),
-                      Catch::Contains("format version 4, but this build reads versions 7, 6 and 5, and 4 only for the "
+                      Catch::Contains("format version 4, but this build reads versions 8, 7, 6 and 5, and 4 only for the "
                                       "linear contact law, which version 4 describes"));
 }
 
@@ -447,11 +460,16 @@ TEMPLATE_TEST_CASE("broken checkpoints raise the documented errors", "[io][check
         CHECK(bytes.compare(40 + name.size(), layout.size(), layout) == 0);
         const std::size_t law_bytes = 16 + name.size() + layout.size(), at = 24 + law_bytes;
         CHECK(bytes.compare(0, 8, "SPHERECK") == 0);
-        CHECK(u32_at(8) == 7);
+        CHECK(u32_at(8) == 8);
         CHECK(u32_at(12) == sizeof(Real));
         CHECK(u64_at(16) == size - 32);
-        CHECK(size == 1184 + law_bytes + 289 * n + 36 * entries); // no bonds, no fluid (docs/io.md)
-        CHECK(u32_at(size - 8 - 4) == 0); // the fluid section's flag: none
+        // no bonds, no fluid, the accumulated displacement (docs/io.md)
+        CHECK(size == 1196 + law_bytes + 313 * n + 36 * entries);
+        const std::size_t displacement = size - 8 - (8 + 24 * n); // its array
+        CHECK(u32_at(displacement - 4) == 1); // settings.accumulated_displacement
+        CHECK(u64_at(displacement) == n);
+        CHECK(f64_at(displacement + 8 + 24 * 5 + 16) == double(sim.snapshot().displacement[5].z));
+        CHECK(u32_at(displacement - 4 - 4) == 0); // the fluid section's flag: none
         CHECK(f64_at(at + 40) == double(sim.config().box.hi.z)); // box.hi = settings bytes 24-47
         CHECK(u32_at(at + 48) == 0); // box.axis[0]: wall
         CHECK(f64_at(at + 60) == double(sim.config().contact.k_n));
@@ -533,11 +551,11 @@ TEMPLATE_TEST_CASE("broken checkpoints raise the documented errors", "[io][check
     SECTION("wrong version")
     {
         std::string b = bytes;
-        REQUIRE(b[8] == 7); // the version, little-endian u32 at byte 8
+        REQUIRE(b[8] == 8); // the version, little-endian u32 at byte 8
         b[8] = 3;
         write_bytes(bad, b);
         REQUIRE_THROWS_WITH(sphere::read_checkpoint<Real>(bad),
-                            where + "format version 3, but this build reads versions 7, 6 and 5, and 4 for the linear contact law");
+                            where + "format version 3, but this build reads versions 8, 7, 6 and 5, and 4 for the linear contact law");
     }
     SECTION("sizes that do not fit the particle count")
     {
@@ -759,6 +777,7 @@ void check_vtu(const std::string& path, const sphere::particle_snapshot<Real>& s
     scalars("pressure", s.pressure);
     scalars("dissipated_viscous", s.e_visc);
     scalars("dissipated_frictional", s.e_fric);
+    vectors("accumulated_displacement", s.displacement);
     std::vector<std::string> kinds;
     for (const std::uint8_t k : s.kind) kinds.push_back(std::to_string(unsigned(k)));
     CHECK(vtk_array(xml, "kind") == kinds);

@@ -9,6 +9,8 @@ Usage: test_program.py SPHERE INPUT.ck SCRATCH
   example's checkpoint) and in double with velocity Verlet.
 - The plan: the run ends at the first step at or after --total, outputs every interval, the
   status file's first line (time, percent, last output) as the original sphere's status.dat.
+- --render: a picture of the input alone (without --total), and one per output of a run, PNG
+  files that Pillow opens (800 x 800 RGB, the method and colour-map range in their text).
 - --dry prints the settings and the plan and writes nothing; --version; bad input (missing,
   truncated and foreign files, a total before the input's time, another run in the folder, the
   CUDA backend in a host build) gives exit status 1 and a message naming the value.
@@ -111,6 +113,30 @@ def killed_and_resumed(tag, *options):
 
 whole = killed_and_resumed("file")
 killed_and_resumed("double-verlet", "--precision", "double", "--integrator", "verlet")
+
+# Pictures (Pillow, Debian's python3-pil for /usr/bin/python3).
+from PIL import Image  # noqa: E402
+
+pictures = os.path.join(SCRATCH, "pictures")
+said = run(input_ck, "--render", "pres", "-o", pictures)
+check("picture of" in said.stdout and os.path.isfile(os.path.join(pictures, "input.png")), "--render without --total: one picture")
+with Image.open(os.path.join(pictures, "input.png")) as im:
+    check(im.size == (800, 800) and im.mode == "RGB", f"the picture is 800 x 800 RGB: {im.size} {im.mode}")
+    check(im.info.get("sphere field") == "pres" and float(im.info.get("sphere max_val", "0")) > 0,
+          f"its text names the method and a positive top of the colour map: {im.info}")
+    check(len(set(im.getdata())) > 50, "the picture shows shaded, coloured spheres")
+run(input_ck, "-t", str(t0 + 2 * interval), "-i", str(interval), "-q", "--no-vtk", "--render", "xdisp",
+    "--max-val", "0.001", "-o", pictures)
+shots = sorted(n for n in os.listdir(pictures) if n.startswith("input.output") and n.endswith(".png"))
+outputs_there = sorted(n for n in os.listdir(pictures) if n.startswith("input.output") and n.endswith(".ck"))
+check(len(shots) >= 3 and [n[:-4] for n in shots] == [n[:-3] for n in outputs_there],
+      f"one picture per output: {shots}, {outputs_there}")
+for n in shots:
+    with Image.open(os.path.join(pictures, n)) as im:
+        check(im.size == (800, 800) and im.info.get("sphere field") == "xdisp" and im.info.get("sphere max_val") == "0.001",
+              f"{n}: {im.size}, {im.info}")
+bad_method = run(input_ck, "--render", "colour", expect=105)
+check("--render: colour not in {" in bad_method.stderr, f"an unknown method is refused: {bad_method.stderr}")
 
 # Bad input: exit status 1 and a message that names the value.
 version = run("--version")

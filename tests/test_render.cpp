@@ -90,7 +90,9 @@ sphere::particle_snapshot<Real> snapshot_of(const sphere::sphere_scene<Real>& sc
     s.v_sync.resize(n);
     s.omega_sync.resize(n);
     s.pressure.resize(n);
+    s.displacement.resize(n);
     for (std::size_t i = 0; i < n; ++i) {
+        s.displacement[i] = {Real(0.5 * i), Real(7), Real(-1)}; // x: 0.5 i
         s.v_sync[i] = {Real(3 * i), Real(4 * i), Real(0)};  // |v| = 5 i
         s.omega_sync[i] = {Real(0), Real(i), Real(0)};    // |omega| = i
         s.pressure[i] = Real(100 * (i + 1));
@@ -312,8 +314,10 @@ TEMPLATE_TEST_CASE("render_particles shows the methods' values and draws the col
     REQUIRE(sphere::particle_values(s, sphere::render_method::pres) == std::vector<Real>{100, 200, 300});
     REQUIRE(sphere::particle_values(s, sphere::render_method::vel) == std::vector<Real>{0, 5, 10});
     REQUIRE(sphere::particle_values(s, sphere::render_method::angvel) == std::vector<Real>{0, 1, 2});
+    REQUIRE(sphere::particle_values(s, sphere::render_method::xdisp) == std::vector<Real>{0, 0.5, 1});
     REQUIRE(sphere::render_method_named("angvel") == sphere::render_method::angvel);
-    REQUIRE_THROWS_WITH(sphere::render_method_named("xdisp"), Catch::Contains("unknown method 'xdisp'"));
+    REQUIRE(sphere::render_method_named("xdisp") == sphere::render_method::xdisp);
+    REQUIRE_THROWS_WITH(sphere::render_method_named("ydisp"), Catch::Contains("unknown method 'ydisp'"));
 
     sphere::render_options options;
     options.view = down_z();

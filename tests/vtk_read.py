@@ -41,7 +41,7 @@ TOLERANCE = {"double": 0.0, "float": 0.0}
 # by its rounding, at most half a float ulp (6e-8 relative); allow 2e-7. Double: 1e-15.
 ANALYTIC = {"double": 1e-15, "float": 2e-7}
 VTK_TYPE = {"double": VTK_DOUBLE, "float": VTK_FLOAT}
-VECTORS = ["velocity", "angular_velocity", "angular_position", "force", "torque"]
+VECTORS = ["velocity", "angular_velocity", "angular_position", "force", "torque", "accumulated_displacement"]
 SCALARS = ["radius", "mass", "pressure", "dissipated_viscous", "dissipated_frictional"]
 
 failures = []

@@ -118,6 +118,8 @@ std::string frame_json(const sphere::simulation<Real>& sim, const std::string& f
     out << ",\n     ";
     scalars(out, "dissipated_frictional", s.e_fric);
     out << ",\n     ";
+    vectors(out, "accumulated_displacement", s.displacement);
+    out << ",\n     ";
     scalars(out, "kind", kind);
     out << ",\n     ";
     scalars(out, "material", material);

@@ -5,6 +5,9 @@
 #include <sphere/io.cuh>
 
 #include <CLI/CLI.hpp>
+#if defined(SPHERE_PROGRAM_PNG)
+#include <sphere/io/render_png.cuh>
+#endif
 
 #include "describe.hpp"
 #include "run_plan.hpp"
@@ -34,6 +37,9 @@ struct options {
     double total = std::numeric_limits<double>::quiet_NaN();
     double interval = std::numeric_limits<double>::quiet_NaN();
     bool dry = false, quiet = false, fresh = false, vtk = true;
+    std::string render;     ///< a render method (normal, pres, vel, angvel, xdisp), or empty: no pictures
+    double max_val = std::numeric_limits<double>::quiet_NaN(); ///< top of the colour map; NaN: each picture's largest value
+    double lower_cutoff = 0; ///< bottom of the colour map; smaller values are not drawn
 };
 
 namespace fs = std::filesystem;
@@ -86,6 +92,29 @@ void remove_earlier_run(const program::run_files& files)
     }
 }
 
+/// Writes the picture of the particles `snap` that --render asks for to `path`
+/// (docs/program.md, *Pictures*): the method's values, the colour map from --lower-cutoff to
+/// --max-val (by default the largest value shown, or lower_cutoff + 1 when none is above it).
+template <class Real>
+void write_picture(const options& o, const sphere::particle_snapshot<Real>& snap, const std::string& path)
+{
+#if defined(SPHERE_PROGRAM_PNG)
+    const sphere::render_method method = sphere::render_method_named(o.render);
+    sphere::render_options style;
+    style.lower_cutoff = o.lower_cutoff;
+    style.max_val = o.max_val;
+    if (std::isnan(o.max_val)) {
+        double largest = o.lower_cutoff;
+        for (Real v : sphere::particle_values(snap, method)) largest = std::max(largest, double(v));
+        style.max_val = largest > o.lower_cutoff ? largest : o.lower_cutoff + 1;
+    }
+    sphere::render_png(path, snap, method, style);
+#else
+    (void)o, (void)snap, (void)path;
+    sphere::detail::fail("--render: this sphere program was built without libpng (Debian: libpng-dev)");
+#endif
+}
+
 /// Runs the checkpoint with the simulation type Sim (its precision, law and integrator).
 template <class Sim>
 int run(const options& o, const std::string& run_name)
@@ -100,6 +129,15 @@ int run(const options& o, const std::string& run_name)
     const double dt = double(input.config.dt);
     const program::run_files files{o.out, fs::path(o.input).stem().string()};
     const double t0 = double(input.state.steps) * dt;
+    if (!o.dry && !o.render.empty() && !std::isfinite(o.total)) { // the original's -r: a picture of the input
+        std::error_code made;
+        fs::create_directories(o.out, made);
+        if (made) sphere::detail::fail("cannot create the output folder '", o.out, "': ", made.message());
+        const std::string path = o.out + "/" + files.name + ".png";
+        write_picture(o, input.state.particles, path);
+        if (!o.quiet) std::printf("picture of %s (%s) in %s\n", o.input.c_str(), o.render.c_str(), path.c_str());
+        return 0;
+    }
     if (!o.dry && !std::isfinite(o.total)) sphere::detail::fail("--total: the simulated time to run to (s) is required");
     const double total = std::isfinite(o.total) ? o.total : t0; // --dry without it: the settings and an empty run
     const double interval = !std::isnan(o.interval) ? o.interval : total > t0 ? (total - t0) / 10 : dt;
@@ -154,6 +192,7 @@ int run(const options& o, const std::string& run_name)
             sphere::write_vtu(files.folder + "/" + files.frame(k), *sim);
             frames.add(sim->time(), files.frame(k));
         }
+        if (!o.render.empty()) write_picture(o, sim->snapshot(), files.folder + "/" + files.numbered(k, ".png"));
         status.time = sim->time();
         status.percent = plan.last > plan.first
                              ? 100.0 * double(sim->steps() - plan.first) / double(plan.last - plan.first)
@@ -239,6 +278,13 @@ int main(int argc, char** argv)
     app.add_flag("-n,--dry", o.dry, "print the settings, the time step and the plan of the run; run nothing");
     app.add_flag("--fresh", o.fresh, "start from the input, replacing an earlier run's output of it");
     app.add_flag("!--no-vtk", o.vtk, "write no VTK frames");
+    app.add_option("-r,--render", o.render,
+                   "also write a PNG picture of every output, coloured by normal, pres, vel, angvel or xdisp; "
+                   "without --total, only a picture of the input")
+        ->check(CLI::IsMember({"normal", "pres", "vel", "angvel", "xdisp"}));
+    app.add_option("--max-val", o.max_val, "top of the pictures' colour map (default: each picture's largest value)");
+    app.add_option("--lower-cutoff", o.lower_cutoff, "bottom of the colour map; particles below it are not drawn")
+        ->capture_default_str();
     app.add_flag("-q,--quiet", o.quiet, "no progress line and no summary");
     CLI11_PARSE(app, argc, argv);
     try {

@@ -43,6 +43,11 @@ struct settings {
     /// original sphere); off leaves it at zero and does not allocate it (24 B per particle in
     /// double).
     bool angular_position = true;
+    /// Integrate each particle's displacement since its simulation began, sum of v dt (m; the
+    /// VTK field accumulated_displacement, the original sphere's xysum: how far a sheared layer
+    /// has travelled, unwrapped across periodic boundaries); off leaves it at zero and does not
+    /// allocate it (24 B per particle in double and mixed, 12 B in float).
+    bool accumulated_displacement = true;
     /// Store the particles in the neighbour grid's cell order, permuted at every rebuild (nearby
     /// particles sit nearby in memory: about 2x faster on a large, spatially unsorted input);
     /// false keeps the user's order. Results are the same bits either way: every sum follows

@@ -357,7 +357,8 @@ public:
         }
 
         particles_ = particle_state<Precision, Policy>(particles, Integrator::distinct_synchronous_velocity,
-                                                       s.energy_audit, s.angular_position);
+                                                       s.energy_audit, s.angular_position,
+                                                       s.accumulated_displacement);
         for (const particle<Coord>& p : particles) {
             kinds_.push_back(p.kind);
             if (p.kind == motion::prescribed || p.kind == motion::prescribed_horizontal) drive_ = true;
@@ -644,13 +645,14 @@ public:
         if (s.particles.size() != size())
             detail::fail("restore: the state holds ", s.particles.size(), " particles, the simulation ", size());
         const particle_snapshot<Coord>& q = s.particles;
-        const char* names[15] = {"v",      "omega",  "v_sync", "omega_sync", "angpos", "force", "torque", "mass",
-                                 "pressure", "e_visc", "e_fric", "p_visc",     "p_fric", "kind",  "material"};
-        const std::size_t counts[15] = {q.v.size(),      q.omega.size(),  q.v_sync.size(), q.omega_sync.size(),
+        const char* names[16] = {"v",      "omega",  "v_sync", "omega_sync", "angpos", "force", "torque", "mass",
+                                 "pressure", "e_visc", "e_fric", "p_visc",     "p_fric", "kind",  "material",
+                                 "displacement"};
+        const std::size_t counts[16] = {q.v.size(),      q.omega.size(),  q.v_sync.size(), q.omega_sync.size(),
                                         q.angpos.size(), q.force.size(),  q.torque.size(), q.mass.size(),
                                         q.pressure.size(), q.e_visc.size(), q.e_fric.size(), q.p_visc.size(),
-                                        q.p_fric.size(), q.kind.size(),   q.material.size()};
-        for (int k = 0; k < 15; ++k)
+                                        q.p_fric.size(), q.kind.size(),   q.material.size(), q.displacement.size()};
+        for (int k = 0; k < 16; ++k)
             if (counts[k] != size())
                 detail::fail("restore: the state's particles.", names[k], " holds ", counts[k], " values for ", size(),
                              " particles");
@@ -782,7 +784,7 @@ public:
             ps.omega.push_back(a.angular_velocity);
             ps.v_sync.push_back(a.velocity);
             ps.omega_sync.push_back(a.angular_velocity);
-            for (auto* field : {&ps.angpos, &ps.force, &ps.torque}) field->push_back({0, 0, 0});
+            for (auto* field : {&ps.angpos, &ps.force, &ps.torque, &ps.displacement}) field->push_back({0, 0, 0});
             ps.mass.push_back(sphere_mass(a.radius, a.density));
             for (auto* field : {&ps.pressure, &ps.e_visc, &ps.e_fric, &ps.p_visc, &ps.p_fric}) field->push_back(0);
             ps.kind.push_back(static_cast<std::uint8_t>(a.kind));
@@ -977,14 +979,18 @@ private:
     /// check, in the drift's pass, costs less than a second copy of its arithmetic.
     bool predicts_drift() const { return summation_ == pair_summation::gather; }
 
-    /// Advances the angular positions (settings.angular_position) with the angular velocities
-    /// the step has just set, unless *halt (policy memory; detail::unless_halted).
+    /// Advances the angular positions (settings.angular_position) and the accumulated
+    /// displacements (settings.accumulated_displacement) with the velocities the step has just
+    /// set, unless *halt (policy memory; detail::unless_halted).
     void turn(const unsigned* halt)
     {
         const particle_view<Precision> p = particles_.view();
         if (p.angpos)
             for_each_index(Policy{}, p.n,
                            detail::unless_halted<detail::turn_particles<Precision>>{{p, Real(dt_)}, halt});
+        if (p.displacement)
+            for_each_index(Policy{}, p.n,
+                           detail::unless_halted<detail::displace_particles<Precision>>{{p, Coord(dt_)}, halt});
     }
 
     /// The forces of the current positions, leaving the contacts' histories and the energy

@@ -158,6 +158,19 @@ struct turn_particles {
     SPHERE_HDI void operator()(std::size_t i) const { p.angpos[i] += p.omega[i] * dt; }
 };
 
+/// Adds v dt to particle i's accumulated displacement, with the velocity that the step has just
+/// moved it by (semi-implicit Euler's new velocity; velocity Verlet's mid-step velocity when run
+/// after its drift; Taylor's second-order term a dt^2 / 2 is not in it), in the positions'
+/// precision: a pass of its own, run only with settings.accumulated_displacement
+/// (docs/physics.md, "Accumulated displacement").
+template <class P>
+struct displace_particles {
+    using Coord = coord_t<P>;
+    particle_view<P> p;
+    Coord dt;
+    SPHERE_HDI void operator()(std::size_t i) const { p.displacement[i] += vec_cast<Coord>(p.v[i]) * dt; }
+};
+
 /// The post-step check of particle i: the squared displacement since the contact lists were
 /// built (m^2), or +infinity when the particle is non-finite or outside the walls on a wall
 /// axis (`bad`). The largest over all particles decides on a rebuild, and +infinity sends

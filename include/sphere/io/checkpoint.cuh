@@ -52,10 +52,11 @@
 
 namespace sphere {
 
-/// The checkpoint format version this build writes. It also reads version 6, which predates
+/// The checkpoint format version this build writes. It also reads version 7, which predates
+/// the accumulated displacement, version 6, which predates
 /// the fluid section, version 5, which predates the bonds, and version 4, which predates the
 /// contact-law interface and holds the linear law's parameters without the law's name.
-inline constexpr std::uint32_t checkpoint_format_version = 7;
+inline constexpr std::uint32_t checkpoint_format_version = 8;
 
 /// The first 8 bytes of every checkpoint.
 inline constexpr char checkpoint_magic[9] = "SPHERECK";
@@ -453,6 +454,10 @@ std::string encode_checkpoint(const settings<Real, typename Law::template params
             e.u64(x.value);
         }
     }
+    // The accumulated displacement (format 8): settings.accumulated_displacement, and with it
+    // each particle's.
+    e.u32(config.accumulated_displacement ? 1u : 0u);
+    if (config.accumulated_displacement) e.array(p.displacement, put_v3);
 
     const std::uint64_t payload = e.bytes.size() - detail::checkpoint_header_bytes;
     for (int k = 0; k < 8; ++k) e.bytes[16 + k] = static_cast<char>((payload >> (8 * k)) & 0xffu);
@@ -490,7 +495,7 @@ inline checkpoint_decoder open_checkpoint(const std::string& bytes, const std::s
     const std::uint32_t version = head.u32("the format version");
     if (version < 4 || version > checkpoint_format_version)
         fail("checkpoint '", path, "': format version ", version, ", but this build reads versions ",
-             checkpoint_format_version, ", 6 and 5, and 4 for the linear contact law");
+             checkpoint_format_version, ", 7, 6 and 5, and 4 for the linear contact law");
     const std::uint32_t precision = head.u32("the writer's precision");
     const std::uint64_t payload = head.u64("the payload size");
     if (payload > std::numeric_limits<std::uint64_t>::max() - head_bytes - tail)
@@ -553,7 +558,7 @@ checkpoint_data<Real, Law> decode_checkpoint(const std::string& bytes, const std
     const std::uint32_t version = header.version;
     if (version == 4 && !linear_params)
         detail::fail("checkpoint '", path, "': format version 4, but this build reads versions ",
-                     checkpoint_format_version, ", 6 and 5, and 4 only for the linear contact law, which version 4 "
+                     checkpoint_format_version, ", 7, 6 and 5, and 4 only for the linear contact law, which version 4 "
                      "describes");
     if (version >= 5 && (header.law != Law::name() || header.history_layout != Law::history_layout))
         detail::fail("checkpoint '", path, "': written with the contact law ", header.law, " (history: ",
@@ -675,6 +680,10 @@ checkpoint_data<Real, Law> decode_checkpoint(const std::string& bytes, const std
                                " particles) with broken flag ", unsigned(b.broken[k]), " (0 or 1)");
     }
     if (version >= 7 && d.choice("the fluid section's flag", 1) == 1) c.fluid = detail::decode_fluid_section<Real>(d);
+    // A file before format 8 holds no accumulated displacement: it restarts without one.
+    s.accumulated_displacement = version >= 8 && d.choice("settings.accumulated_displacement", 1) == 1;
+    if (s.accumulated_displacement) p.displacement = d.array<vec3<Real>>("the accumulated displacements", n, 24, get_v3);
+    else p.displacement.assign(n, vec3<Real>{0, 0, 0});
     if (d.left() != 0) d.inconsistent(d.left(), " bytes follow the last array");
     for (std::size_t i = 0; i < n; ++i)
         for (std::size_t e = t.begin(i); e < t.end(i); ++e) {

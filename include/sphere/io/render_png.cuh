@@ -34,7 +34,7 @@ void render_png(const std::string& path, const particle_snapshot<Real>& s, const
 }
 
 /// Writes the snapshot's particles as method m shows them (render/fields.cuh: normal, pres,
-/// vel, angvel) to the PNG file `path`.
+/// vel, angvel, xdisp) to the PNG file `path`.
 template <class Policy = host, class Real>
 void render_png(const std::string& path, const particle_snapshot<Real>& s, render_method m, const render_options& options = {})
 {

@@ -167,6 +167,9 @@ std::string vtu_text(const particle_snapshot<Real>& p, double time)
     detail::vtk_scalars(out, "pressure", p.pressure);
     detail::vtk_scalars(out, "dissipated_viscous", p.e_visc);
     detail::vtk_scalars(out, "dissipated_frictional", p.e_fric);
+    // zeros for a snapshot made without the field (one built by hand)
+    detail::vtk_vectors(out, "accumulated_displacement",
+                        p.displacement.size() == n ? p.displacement : std::vector<vec3<Real>>(n, vec3<Real>{0, 0, 0}));
     out << "        <DataArray type=\"UInt8\" Name=\"kind\" format=\"ascii\">\n";
     for (std::size_t i = 0; i < n; ++i) out << "          " << unsigned(p.kind[i]) << '\n';
     out << "        </DataArray>\n";
@@ -184,7 +187,8 @@ std::string vtu_text(const particle_snapshot<Real>& p, double time)
 /// Points are the particle centres (m); point data: radius (m), velocity (m/s) and
 /// angular_velocity (rad/s) at the time of the positions (v_sync, omega_sync), angular_position
 /// (rad), force (N) and torque (N m) of the last step's contacts, mass (kg), pressure (Pa),
-/// dissipated_viscous and dissipated_frictional (J), kind (0 free, 1 prescribed, 2 fixed, 3 prescribed_horizontal),
+/// dissipated_viscous and dissipated_frictional (J), accumulated_displacement (m, sum of v dt:
+/// settings.accumulated_displacement), kind (0 free, 1 prescribed, 2 fixed, 3 prescribed_horizontal),
 /// material (the material index, contact::materials);
 /// field data TimeValue (s). Throws sphere::error naming the file when it cannot be written.
 template <class Real>

@@ -46,6 +46,10 @@ struct particle_view {
     std::uint8_t* kind;     ///< motion, as its underlying value
     std::uint8_t* material; ///< material index (contact::materials)
     unsigned* user;         ///< the user's index of the particle in each storage slot
+    /// Displacement since the simulation began, sum of v dt (m), in coord_t<P> (a sum of small
+    /// steps that float would round away in mixed precision); null without
+    /// settings.accumulated_displacement.
+    vec3<Coord>* displacement;
 };
 
 namespace detail {
@@ -85,6 +89,7 @@ struct particle_snapshot {
     std::vector<Real> mass, pressure, e_visc, e_fric, p_visc, p_fric;
     std::vector<std::uint8_t> kind;
     std::vector<std::uint8_t> material;
+    std::vector<vec3<Real>> displacement; ///< accumulated displacement (m); zeros when not kept
 
     std::size_t size() const { return x.size(); }
     vec3<Real> position(std::size_t i) const { return x[i].xyz(); }
@@ -124,10 +129,12 @@ public:
     /// velocities at the positions' time are the velocities themselves (every integrator but
     /// semi-implicit Euler): v_sync and omega_sync then share v's and omega's arrays. Without
     /// `audit` there are no energy-audit arrays (pressure, dissipation): snapshots show zeros.
-    /// Without `angular_position` there is no angular-position array (snapshots show zeros).
+    /// Without `angular_position` there is no angular-position array, without `displacement`
+    /// no accumulated-displacement array (snapshots show zeros).
     explicit particle_state(const std::vector<particle<Coord>>& particles, bool distinct_sync = true,
-                            bool audit = true, bool angular_position = true)
-        : distinct_sync_(distinct_sync), audit_(audit), angular_position_(angular_position)
+                            bool audit = true, bool angular_position = true, bool displacement = true)
+        : distinct_sync_(distinct_sync), audit_(audit), angular_position_(angular_position),
+          displacement_kept_(displacement)
     {
         // One field at a time, straight from the descriptions (storage order = user order
         // until the first rebuild): set-up needs one field's copy beside the arrays.
@@ -154,6 +161,8 @@ public:
             field(omega_sync_, spin);
         }
         if (angular_position_) angpos_.resize(n, zero);
+        if (displacement_kept_) displacement_.resize(n, vec3<Coord>{0, 0, 0});
+        if (displacement_kept_ && !std::is_same_v<Real, Coord>) wide_scratch_.resize(n, vec3<Coord>{0, 0, 0});
         force_.resize(n, zero);
         torque_.resize(n, zero);
         field(mass_, [](const particle<Coord>& p) { return Real(sphere_mass(p.radius, p.density)); });
@@ -174,10 +183,11 @@ public:
         vec3<Real>* omega_sync = distinct_sync_ ? omega_sync_.data() : omega_.data();
         auto audit = [&](buffer<Real, Policy>& b) { return audit_ ? b.data() : nullptr; };
         vec3<Real>* angpos = angular_position_ ? angpos_.data() : nullptr;
+        vec3<Coord>* displacement = displacement_kept_ ? displacement_.data() : nullptr;
         return {x_.size(),       x_.data(),        v_.data(),         omega_.data(),     v_sync,
                 omega_sync,      angpos,           force_.data(),     torque_.data(),    mass_.data(),
                 audit(pressure_), audit(e_visc_), audit(e_fric_),   audit(p_visc_),    audit(p_fric_),
-                kind_.data(),    material_.data(), user_.data()};
+                kind_.data(),    material_.data(), user_.data(),      displacement};
     }
 
     /// The user's index of the particle in each storage slot (host copy).
@@ -223,7 +233,8 @@ public:
         return {out(x_),     out(v_),      out(omega_),  out(distinct_sync_ ? v_sync_ : v_),
                 out(distinct_sync_ ? omega_sync_ : omega_),
                 out(angpos_), out(force_),  out(torque_), out(mass_),   out(pressure_),
-                out(e_visc_), out(e_fric_), out(p_visc_), out(p_fric_), out(kind_), out(material_)};
+                out(e_visc_), out(e_fric_), out(p_visc_), out(p_fric_), out(kind_), out(material_),
+                out(displacement_)};
     }
 
     /// Replaces every field by a snapshot's, given in user order (for restarts and for
@@ -257,16 +268,23 @@ public:
         }
         in(kind_, s.kind);
         in(material_, s.material);
+        if (displacement_kept_) in(displacement_, s.displacement);
     }
 
 private:
     /// A stored value in the snapshot's type, and back (identity unless P is mixed).
     static vec4<Coord> widen(const vec4<Coord>& a) { return a; }
     static vec3<Coord> widen(const vec3<Real>& a) { return vec_cast<Coord>(a); }
+    template <class R = Real, class = std::enable_if_t<!std::is_same_v<R, Coord>>>
+    static vec3<Coord> widen(const vec3<Coord>& a) { return a; }
     static Coord widen(Real a) { return Coord(a); }
     static std::uint8_t widen(std::uint8_t a) { return a; }
     template <class T> static T narrow(const vec4<Coord>& a) { return a; }
-    template <class T> static T narrow(const vec3<Coord>& a) { return vec_cast<Real>(a); }
+    template <class T> static T narrow(const vec3<Coord>& a)
+    {
+        if constexpr (std::is_same_v<T, vec3<Coord>>) return a; // the accumulated displacement
+        else return vec_cast<Real>(a);
+    }
     template <class T> static T narrow(Coord a) { return T(a); }
     template <class T> static T narrow(std::uint8_t a) { return a; }
 
@@ -277,7 +295,7 @@ private:
     {
         f(v_); f(omega_); f(v_sync_); f(omega_sync_); f(angpos_); f(torque_);
         f(mass_); f(pressure_); f(e_visc_); f(e_fric_); f(p_visc_); f(p_fric_); f(kind_);
-        f(material_);
+        f(material_); f(displacement_);
     }
 
     /// Moves every carried field, the user indices and the `along` arrays through `order` by
@@ -292,13 +310,20 @@ private:
         for_each_index(Policy{}, force_.size(), detail::fill_value<vec3<Real>>{force_.data(), {0, 0, 0}});
     }
 
-    /// Moves one field through `order` by `Move` into the forces' array and copies it back.
+    /// Moves one field through `order` by `Move` into the forces' array (for the accumulated
+    /// displacement of mixed precision, wider than a force, into wide_scratch_) and copies it
+    /// back.
     template <template <class> class Move, class T>
     void move_field(buffer<T, Policy>& field, const unsigned* order)
     {
-        static_assert(sizeof(T) <= sizeof(vec3<Real>) && alignof(T) <= alignof(vec3<Real>), "scratch too narrow");
-        T* tmp = reinterpret_cast<T*>(force_.data());
         const std::size_t n = field.size();
+        T* tmp;
+        if constexpr (sizeof(T) <= sizeof(vec3<Real>) && alignof(T) <= alignof(vec3<Real>)) {
+            tmp = reinterpret_cast<T*>(force_.data());
+        } else {
+            static_assert(std::is_same_v<T, vec3<Coord>>, "only the accumulated displacement is wider than a force");
+            tmp = wide_scratch_.data();
+        }
         for_each_index(Policy{}, n, Move<T>{field.data(), order, tmp});
         for_each_index(Policy{}, n, detail::copy_back<T>{tmp, field.data()});
     }
@@ -311,6 +336,11 @@ private:
     bool distinct_sync_ = true; ///< v_sync_, omega_sync_ hold their own values (else empty: v_, omega_)
     bool audit_ = true;         ///< the energy-audit arrays exist (else empty)
     bool angular_position_ = true; ///< angpos_ exists (else empty)
+    buffer<vec3<Coord>, Policy> displacement_;
+    /// The permutation's scratch for displacement_ where it is wider than a force (mixed
+    /// precision only: 24 B per particle more there).
+    buffer<vec3<Coord>, Policy> wide_scratch_;
+    bool displacement_kept_ = true; ///< displacement_ exists (else empty)
 };
 
 } // namespace sphere
