@@ -33,8 +33,8 @@ def check(condition, what):
         print("FAIL:", what)
 
 
-def run(*args, expect=0):
-    r = subprocess.run([SPHERE, *args], capture_output=True, text=True, timeout=300)
+def run(*args, expect=0, env=None):
+    r = subprocess.run([SPHERE, *args], capture_output=True, text=True, timeout=300, env=env)
     check(r.returncode == expect, f"sphere {' '.join(args)}: exit {r.returncode}, expected {expect}\n{r.stdout}{r.stderr}")
     return r
 
@@ -135,6 +135,27 @@ for n in shots:
     with Image.open(os.path.join(pictures, n)) as im:
         check(im.size == (800, 800) and im.info.get("sphere field") == "xdisp" and im.info.get("sphere max_val") == "0.001",
               f"{n}: {im.size}, {im.info}")
+# --film: ffmpeg started with the pictures and the film's path (a stand-in ffmpeg on the PATH
+# records its arguments and writes the film), and a note when there is none.
+tools = os.path.join(SCRATCH, "tools")
+os.makedirs(tools)
+with open(os.path.join(tools, "ffmpeg"), "w") as f:
+    f.write('#!/bin/sh\nprintf "%s\\n" "$@" > "$(dirname "$0")/arguments"\nfor last; do :; done\necho film > "$last"\n')
+os.chmod(os.path.join(tools, "ffmpeg"), 0o755)
+film_dir = os.path.join(SCRATCH, "film")
+with_ffmpeg = dict(os.environ, PATH=tools + os.pathsep + os.environ["PATH"])
+filmed = run(input_ck, "-t", str(t0 + 2 * interval), "-i", str(interval), "--no-vtk", "-r", "vel", "--film", "--fps", "5",
+             "-o", film_dir, env=with_ffmpeg)
+with open(os.path.join(tools, "arguments")) as f:
+    arguments = f.read().split("\n")
+check(os.path.join(film_dir, "input.output%05d.png") in arguments and arguments[arguments.index("-framerate") + 1] == "5.000000"
+      and os.path.isfile(os.path.join(film_dir, "input.mp4")) and "input.mp4" in filmed.stdout,
+      f"--film runs ffmpeg on the pictures: {arguments}\n{filmed.stdout}")
+without = dict(os.environ, PATH=os.path.dirname(shutil.which("sh")))
+bare = run(input_ck, "-t", str(t0 + interval), "-i", str(interval), "-q", "--no-vtk", "-r", "vel", "--film",
+           "-o", os.path.join(SCRATCH, "no-film"), env=without)
+check("--film: no ffmpeg on the PATH" in bare.stderr, f"--film without ffmpeg says so: {bare.stderr}")
+check("--film requires --render" in run(input_ck, "-t", "1", "--film", expect=107).stderr, "--film needs --render")
 bad_method = run(input_ck, "--render", "colour", expect=105)
 check("--render: colour not in {" in bad_method.stderr, f"an unknown method is refused: {bad_method.stderr}")
 

@@ -10,6 +10,7 @@
 #endif
 
 #include "describe.hpp"
+#include "film.hpp"
 #include "run_plan.hpp"
 
 #include <chrono>
@@ -40,6 +41,8 @@ struct options {
     std::string render;     ///< a render method (normal, pres, vel, angvel, xdisp), or empty: no pictures
     double max_val = std::numeric_limits<double>::quiet_NaN(); ///< top of the colour map; NaN: each picture's largest value
     double lower_cutoff = 0; ///< bottom of the colour map; smaller values are not drawn
+    bool film = false;       ///< join the pictures into a video with ffmpeg at the end
+    double fps = 10;         ///< the video's frames per second
 };
 
 namespace fs = std::filesystem;
@@ -213,10 +216,12 @@ int run(const options& o, const std::string& run_name)
         bar.show(sim->steps(), sim->time(), k, k + 1 == plan.outputs());
     }
     bar.end();
+    const bool filmed = o.film && program::write_film(files.folder, files.name, o.fps);
     if (!o.quiet)
-        std::printf("t = %.9g s after %zu steps; output in %s/: %s.output00000 to %05zu (.ck%s), %s.status.dat\n",
+        std::printf("t = %.9g s after %zu steps; output in %s/: %s.output00000 to %05zu (.ck%s%s), %s.status.dat%s\n",
                     sim->time(), sim->steps(), o.out.c_str(), files.name.c_str(), plan.outputs() - 1,
-                    o.vtk ? ", .vtu, .pvd" : "", files.name.c_str());
+                    o.vtk ? ", .vtu, .pvd" : "", o.render.empty() ? "" : ", .png", files.name.c_str(),
+                    filmed ? (", " + files.name + ".mp4").c_str() : "");
     return 0;
 }
 
@@ -282,6 +287,9 @@ int main(int argc, char** argv)
                    "also write a PNG picture of every output, coloured by normal, pres, vel, angvel or xdisp; "
                    "without --total, only a picture of the input")
         ->check(CLI::IsMember({"normal", "pres", "vel", "angvel", "xdisp"}));
+    app.add_flag("--film", o.film, "join the pictures of --render into <name>.mp4 with ffmpeg at the end, when installed")
+        ->needs("--render");
+    app.add_option("--fps", o.fps, "frames per second of the film")->check(CLI::Range(0.01, 1000.0))->capture_default_str();
     app.add_option("--max-val", o.max_val, "top of the pictures' colour map (default: each picture's largest value)");
     app.add_option("--lower-cutoff", o.lower_cutoff, "bottom of the colour map; particles below it are not drawn")
         ->capture_default_str();
