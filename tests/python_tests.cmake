@@ -2,8 +2,9 @@
 # docs/python.md). Each tests/python/test_*.py is one test, python_<name>, run by
 # `${SPHERE_PYTHON} -m pytest` (Debian's python3-pytest, for /usr/bin/python3) with the build's
 # package folder on PYTHONPATH and one OpenMP thread, like the C++ tests. The comparisons with
-# the C++ consolidation example (test_checkpoint.py, test_consolidation.py) run it from
-# SPHERE_CONSOLIDATION; without the examples they are skipped. test_pip_install.py builds the
+# the C++ examples (test_checkpoint.py, test_consolidation.py, test_shear.py) run them from
+# SPHERE_CONSOLIDATION and SPHERE_SHEAR, test_program.py the sphere program from SPHERE_PROGRAM
+# (the package's run_program finds it there too); without them those tests are skipped. test_pip_install.py builds the
 # package again with pip: label slow. Nothing is registered when the package is not built
 # (SPHERE_BUILD_PYTHON OFF).
 
@@ -17,6 +18,12 @@ set(_sphere_python_environment
     ${SPHERE_TEST_ENVIRONMENT})
 if(TARGET consolidation)
     list(APPEND _sphere_python_environment "SPHERE_CONSOLIDATION=$<TARGET_FILE:consolidation>")
+endif()
+if(TARGET shear)
+    list(APPEND _sphere_python_environment "SPHERE_SHEAR=$<TARGET_FILE:shear>")
+endif()
+if(TARGET sphere_program)
+    list(APPEND _sphere_python_environment "SPHERE_PROGRAM=$<TARGET_FILE:sphere_program>")
 endif()
 
 file(GLOB _sphere_python_tests CONFIGURE_DEPENDS "${CMAKE_CURRENT_LIST_DIR}/python/test_*.py")

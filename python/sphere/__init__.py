@@ -2,20 +2,43 @@
 
 The package binds sphere's C++ library (host backend, float and double precision, the linear
 contact law): build a sample (Settings, the set-up helpers), run a Simulation, read and write
-checkpoints, and get every field as NumPy arrays. Errors of the library are sphere.Error, with
-the library's message.
+checkpoints, and get every field as NumPy arrays; the consolidation and shear examples as
+calls (consolidate, shear), the sphere program (run_program, status, read_output), the
+analyses (porosity, stresses, force chains, roses, shear strain), time series (Recorder) and
+figures (sphere.plot, with matplotlib). Errors of the library are sphere.Error, with the
+library's message.
 """
 
 from ._sphere import Error, __version__, gamma_n_from_restitution
-from .consolidation import Consolidation, consolidate, deposited_sample, sample_contact
+from .analysis import (ForceChains, PorosityProfile, Rose, ShearTracker, contact_counts, contact_rose, coordination,
+                       force_chains, orientations, porosity, porosity_profile, rose, stress_tensor, void_ratio,
+                       volume_between_walls, wall_stresses)
+from .consolidation import Consolidation, consolidate
 from .fields import Contacts, Energy, Snapshot, Walls
+from .granular import deposited_sample, sample_contact, saved_sample
+from .program import ProgramRun, Status, find_program, outputs, read_output, run_program, status
+from .record import Recorder
 from .samples import bimodal_radii, deposit, fit_world, lognormal_radii, random_packing, sample_top, uniform_radii
 from .settings import FACES, ContactParams, Settings, WallControl
+from .shear import Shear, ShearSeries, shear
 from .simulation import MOTION_KINDS, PRECISIONS, Simulation, read_checkpoint
 
 __all__ = [
-    "FACES", "MOTION_KINDS", "PRECISIONS", "Consolidation", "ContactParams", "Contacts", "Energy", "Error", "Settings",
-    "Simulation", "Snapshot", "WallControl", "Walls", "__version__", "bimodal_radii", "consolidate", "deposit",
-    "deposited_sample", "fit_world", "gamma_n_from_restitution", "lognormal_radii", "random_packing", "read_checkpoint",
-    "sample_top", "uniform_radii",
+    "__version__", "bimodal_radii", "consolidate", "Consolidation", "contact_counts", "contact_rose", "ContactParams",
+    "Contacts", "coordination", "deposit", "deposited_sample", "Energy", "Error", "FACES", "find_program",
+    "fit_world", "force_chains", "ForceChains", "gamma_n_from_restitution", "lognormal_radii", "MOTION_KINDS",
+    "orientations", "outputs", "porosity", "porosity_profile", "PorosityProfile", "PRECISIONS", "ProgramRun",
+    "random_packing", "read_checkpoint", "read_output", "Recorder", "Rose", "rose", "run_program", "sample_contact",
+    "sample_top", "saved_sample", "Settings", "Shear", "shear", "ShearSeries", "ShearTracker", "Simulation",
+    "Snapshot", "Status", "status", "stress_tensor", "uniform_radii", "void_ratio", "volume_between_walls",
+    "wall_stresses", "WallControl", "Walls",
 ]
+
+
+def __getattr__(name):
+    """sphere.plot, imported on first use (it loads matplotlib)."""
+    if name == "plot":
+        import importlib
+
+        return importlib.import_module(".plot", __name__)
+    raise AttributeError(f"module 'sphere' has no attribute {name!r}")

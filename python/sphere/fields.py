@@ -23,6 +23,9 @@ class Snapshot:
         velocities (semi-implicit Euler: those of the last position update, half a step away
         from the positions' time).
     angular_positions (N, 3): integrated rotation (rad); zero without settings.angular_position.
+    displacements (N, 3): accumulated displacement since the start, sum of v dt (m), unwrapped
+        across periodic boundaries (the original's xysum); zero without
+        settings.accumulated_displacement.
     forces, torques (N, 3): sums of the contact forces (N) and torques (N m) of the last step,
         gravity left out.
     pressures (N,): the normal contact forces' magnitudes summed over the surface (Pa).
@@ -41,6 +44,7 @@ class Snapshot:
     integrator_velocities: np.ndarray
     integrator_angular_velocities: np.ndarray
     angular_positions: np.ndarray
+    displacements: np.ndarray
     forces: np.ndarray
     torques: np.ndarray
     masses: np.ndarray

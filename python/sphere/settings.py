@@ -86,6 +86,8 @@ class Settings:
     contact_forces: keep each contact's force of the last step (Simulation.contacts()).
     energy_audit: book the dissipated energies every step (Simulation.energy() closes).
     angular_position: integrate each particle's angular position.
+    accumulated_displacement: integrate each particle's displacement since the start (m, sum of
+        v dt, unwrapped across periodic boundaries: the original's xysum).
     reorder: store the particles in the grid's cell order (the same results either way).
     pair_summation: 'automatic', 'slabs' or 'gather' (docs/architecture.md).
     walls: six WallControls, faces x-, x+, y-, y+, z-, z+ (FACES); all fixed by default.
@@ -105,6 +107,7 @@ class Settings:
     contact_forces: bool = True
     energy_audit: bool = True
     angular_position: bool = True
+    accumulated_displacement: bool = True
     reorder: bool = True
     pair_summation: str = "automatic"
     walls: list = field(default_factory=_fixed_walls)

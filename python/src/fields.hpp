@@ -23,6 +23,7 @@ py::dict snapshot_of(const sphere::particle_snapshot<Real>& s)
     d["integrator_velocities"] = rows(s.v);
     d["integrator_angular_velocities"] = rows(s.omega);
     d["angular_positions"] = rows(s.angpos);
+    d["displacements"] = rows(s.displacement);
     d["forces"] = rows(s.force);
     d["torques"] = rows(s.torque);
     d["masses"] = column(s.mass);

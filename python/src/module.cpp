@@ -1,7 +1,7 @@
 // The extension module sphere._sphere (docs/python.md): the library's error as sphere.Error,
 // the project's version, the precision-independent helpers and a submodule per precision
 // (float.cpp, double.cpp).
-#include "common.hpp"
+#include "analysis.hpp"
 
 PYBIND11_MODULE(_sphere, m)
 {
@@ -18,6 +18,7 @@ PYBIND11_MODULE(_sphere, m)
         py::arg("restitution"), py::arg("effective_mass"), py::arg("k_n"), py::arg("tension") = false,
         "Normal viscosity gamma_n (N s/m) that gives a contact of effective mass m_eff (kg) and normal stiffness "
         "k_n (N/m) the restitution coefficient e (contact/restitution.cuh).");
+    sphere_python::bind_orientations(m);
     sphere_python::bind_float(m);
     sphere_python::bind_double(m);
 }

@@ -98,6 +98,7 @@ sphere::settings<Real> settings_from(py::handle s)
     out.contact_forces = flag(s.attr("contact_forces"), "settings.contact_forces");
     out.energy_audit = flag(s.attr("energy_audit"), "settings.energy_audit");
     out.angular_position = flag(s.attr("angular_position"), "settings.angular_position");
+    out.accumulated_displacement = flag(s.attr("accumulated_displacement"), "settings.accumulated_displacement");
     out.reorder = flag(s.attr("reorder"), "settings.reorder");
     out.pair_summation = parse<sphere::pair_summation>(s.attr("pair_summation"), "settings.pair_summation");
     const py::object walls = s.attr("walls");
@@ -125,6 +126,7 @@ py::object settings_to(const sphere::settings<Real>& s)
                           py::arg("max_initial_overlap") = double(s.max_initial_overlap),
                           py::arg("cell_size") = double(s.cell_size), py::arg("contact_forces") = s.contact_forces,
                           py::arg("energy_audit") = s.energy_audit, py::arg("angular_position") = s.angular_position,
+                          py::arg("accumulated_displacement") = s.accumulated_displacement,
                           py::arg("reorder") = s.reorder, py::arg("pair_summation") = name_of(s.pair_summation),
                           py::arg("walls") = walls);
 }

@@ -1,8 +1,8 @@
 """Shared by the tests of the Python package sphere. tests/python_tests.cmake runs each test file
 with /usr/bin/python3 -m pytest, PYTHONPATH at the build's package folder (build/python),
-OMP_NUM_THREADS=1, SPHERE_SOURCE_DIR at the repository and SPHERE_CONSOLIDATION at the C++
-consolidation example (unset when the examples are not built: the tests that compare with it
-are skipped then)."""
+OMP_NUM_THREADS=1, SPHERE_SOURCE_DIR at the repository, SPHERE_CONSOLIDATION and SPHERE_SHEAR at
+the C++ consolidation and shear examples and SPHERE_PROGRAM at the sphere program (each unset
+when it is not built: the tests that run it are skipped then)."""
 
 import os
 import subprocess
@@ -48,3 +48,19 @@ def cpp_consolidation(tmp_path_factory):
         return runs[precision, duration]
 
     return run
+
+
+def cpp_program(variable, what):
+    """The path in environment variable `variable`; skips the test when it is unset."""
+    program = os.environ.get(variable)
+    if not program:
+        pytest.skip(f"{variable} is not set: {what} is not built")
+    return program
+
+
+def run_example(program, out, *options):
+    """Runs a C++ example quietly into folder `out` with `options`; returns its standard output
+    without the last line ('output in <folder>: ...', which names the folder)."""
+    done = subprocess.run([program, *map(str, options), "-q", "-o", str(out)], capture_output=True, text=True,
+                          check=True)
+    return [line for line in done.stdout.splitlines() if not line.startswith("output in")]

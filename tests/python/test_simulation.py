@@ -28,6 +28,11 @@ def test_free_fall(precision):
     assert abs(z - (z0 - G * t * t / 2)) <= G * t * dt / 2 + steps * eps(precision) * z0
     assert z0 - z > 0.01  # it did fall (t = 0.05 s)
     assert sim.snapshot().positions[0, :2].tolist() == [0.5, 0.5]
+    # The accumulated displacement is the sum of the same steps: the fall, to the rounding.
+    d = sim.snapshot().displacements[0]
+    assert d[0] == 0 and d[1] == 0
+    assert abs(float(d[2]) - (z - z0)) <= steps * eps(precision) * z0
+    assert sim.settings.accumulated_displacement
 
 
 def collision(precision, restitution):

@@ -1,0 +1,133 @@
+"""Figures of sphere's results with matplotlib (the Agg backend: no display needed): the energy
+budget, the walls, a shear test, a rose diagram and a porosity profile. Each function draws on
+a new matplotlib Figure, saves it to `path` (PNG, or any format matplotlib writes, by the
+extension) when given, and returns the Figure. Import it as sphere.plot (matplotlib is loaded
+only then)."""
+
+import os
+
+import numpy as np
+from matplotlib.figure import Figure
+
+from ._sphere import Error
+from .analysis import PorosityProfile, Rose, contact_rose, porosity_profile as _profile
+from .record import Recorder
+from .settings import FACES
+from .shear import Shear, ShearSeries
+from .simulation import Simulation
+
+ENERGY_TERMS = ["kinetic", "rotational", "potential", "elastic", "dissipated_viscous", "dissipated_friction",
+                "boundary_work", "total"]
+
+
+def _finish(fig, path):
+    if path is not None:
+        fig.savefig(os.fspath(path), dpi=100)
+    return fig
+
+
+def _wrong(what, value, expected):
+    return Error(f"sphere: plot.{what}: {type(value).__name__} given; {expected} is needed")
+
+
+def energy(source, path=None):
+    """The energy budget (J): with a sphere.Recorder, each term and the balance total - total[0]
+    against time; with a Simulation, its current terms as bars."""
+    fig = Figure(figsize=(8, 6), layout="constrained")
+    if isinstance(source, Simulation):
+        e = source.energy()
+        ax = fig.add_subplot()
+        values = [getattr(e, name) for name in ENERGY_TERMS]
+        ax.bar(range(len(values)), values)
+        ax.set_xticks(range(len(values)), [n.replace("_", "\n") for n in ENERGY_TERMS], fontsize=8)
+        ax.set_ylabel("energy (J)")
+        ax.set_title(f"energy at t = {source.time:.4g} s")
+        return _finish(fig, path)
+    if not isinstance(source, Recorder):
+        raise _wrong("energy", source, "a sphere.Recorder or a sphere.Simulation")
+    t, e = source.time, source.energy
+    top, bottom = fig.subplots(2, 1, sharex=True)
+    for name in ENERGY_TERMS:
+        top.plot(t, e[name], label=name.replace("_", " "))
+    top.set_ylabel("energy (J)")
+    top.legend(fontsize=7)
+    bottom.plot(t, e["total"] - e["total"][0] if len(t) else t)
+    bottom.set_ylabel("total - total(0) (J)")
+    bottom.set_xlabel("time (s)")
+    return _finish(fig, path)
+
+
+def walls(recorder, path=None):
+    """The walls of a sphere.Recorder against time: positions (m), the particles' forces (N)
+    and normal stresses (Pa) of every active wall face."""
+    if not isinstance(recorder, Recorder):
+        raise _wrong("walls", recorder, "a sphere.Recorder")
+    fig = Figure(figsize=(8, 8), layout="constrained")
+    axes = fig.subplots(3, 1, sharex=True)
+    t = recorder.time
+    for f in np.flatnonzero(recorder.active):
+        axes[0].plot(t, recorder.wall_position[:, f], label=FACES[f])
+        axes[1].plot(t, recorder.wall_force[:, f], label=FACES[f])
+        axes[2].plot(t, recorder.wall_stress[:, f], label=FACES[f])
+    for ax, label in zip(axes, ["position (m)", "force (N)", "normal stress (Pa)"]):
+        ax.set_ylabel(label)
+        ax.legend(fontsize=7)
+    axes[-1].set_xlabel("time (s)")
+    return _finish(fig, path)
+
+
+def shear(result, path=None):
+    """A shear test (a sphere.Shear or its ShearSeries) against shear strain: shear and normal
+    stress (Pa), tau/sigma and dilation (m)."""
+    series = result.series if isinstance(result, Shear) else result
+    if not isinstance(series, ShearSeries):
+        raise _wrong("shear", result, "a sphere.Shear or sphere.ShearSeries")
+    fig = Figure(figsize=(8, 8), layout="constrained")
+    axes = fig.subplots(3, 1, sharex=True)
+    axes[0].plot(series.strain, series.shear_stress, label="shear stress tau")
+    axes[0].plot(series.strain, series.normal_stress, label="normal stress sigma")
+    axes[0].set_ylabel("stress (Pa)")
+    axes[0].legend(fontsize=7)
+    axes[1].plot(series.strain, series.friction)
+    axes[1].set_ylabel("tau / sigma")
+    axes[2].plot(series.strain, series.dilation)
+    axes[2].set_ylabel("dilation (m)")
+    axes[2].set_xlabel("shear strain")
+    return _finish(fig, path)
+
+
+def rose(source, path=None, trend_bins=36, plunge_bins=9):
+    """A rose diagram: counts by trend (a polar histogram, north up, clockwise) and by plunge,
+    of a sphere.Rose or of a Simulation's contact network (contact_rose)."""
+    if isinstance(source, Simulation):
+        source = contact_rose(source, trend_bins, plunge_bins)
+    if not isinstance(source, Rose):
+        raise _wrong("rose", source, "a sphere.Rose or a sphere.Simulation")
+    fig = Figure(figsize=(10, 5), layout="constrained")
+    polar = fig.add_subplot(1, 2, 1, projection="polar")
+    polar.set_theta_zero_location("N")
+    polar.set_theta_direction(-1)
+    width = 2 * np.pi / len(source.trend)
+    polar.bar(np.radians(source.trend_edges[:-1]) + width / 2, source.trend, width=width, edgecolor="k")
+    polar.set_title("trend")
+    ax = fig.add_subplot(1, 2, 2)
+    ax.bar(source.plunge_edges[:-1], source.plunge, width=np.diff(source.plunge_edges), align="edge", edgecolor="k")
+    ax.set_xlabel("plunge (degrees)")
+    ax.set_ylabel("count")
+    return _finish(fig, path)
+
+
+def porosity_profile(source, path=None, slices=10):
+    """Porosity against height (m) of a sphere.PorosityProfile or of a Simulation (its profile
+    in `slices` slices between the walls)."""
+    if isinstance(source, Simulation):
+        source = _profile(source, slices)
+    if not isinstance(source, PorosityProfile):
+        raise _wrong("porosity_profile", source, "a sphere.PorosityProfile or a sphere.Simulation")
+    fig = Figure(figsize=(5, 7), layout="constrained")
+    ax = fig.add_subplot()
+    z = np.column_stack([source.z_lo, source.z_hi]).ravel()
+    ax.plot(np.repeat(source.porosity, 2), z)
+    ax.set_xlabel("porosity")
+    ax.set_ylabel("height z (m)")
+    return _finish(fig, path)
