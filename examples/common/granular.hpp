@@ -278,13 +278,12 @@ private:
     std::shared_ptr<sphere::vtk_writer> vtk_;
 };
 
-/// Runs `sim` for `duration` (s) of simulated time as phase `name`, printing a progress line
-/// on stderr about once a second (unless quiet) with what `status` says.
+/// Runs `sim` for `steps` steps as phase `name`, printing a progress line on stderr about once
+/// a second (unless quiet) with what `status` says.
 template <class Sim>
-void run_phase(Sim& sim, const char* name, double duration, bool quiet,
+void run_steps(Sim& sim, const char* name, std::size_t steps, bool quiet,
                const std::function<std::string(const Sim&)>& status)
 {
-    const std::size_t steps = static_cast<std::size_t>(std::llround(duration / double(sim.dt())));
     const auto start = std::chrono::steady_clock::now();
     auto last = start;
     const std::size_t chunk = 100;
@@ -301,6 +300,15 @@ void run_phase(Sim& sim, const char* name, double duration, bool quiet,
         }
     }
     if (!quiet) std::fprintf(stderr, "\n");
+}
+
+/// Runs `sim` for `duration` (s) of simulated time, rounded to whole steps, as phase `name`
+/// (run_steps).
+template <class Sim>
+void run_phase(Sim& sim, const char* name, double duration, bool quiet,
+               const std::function<std::string(const Sim&)>& status)
+{
+    run_steps<Sim>(sim, name, static_cast<std::size_t>(std::llround(duration / double(sim.dt()))), quiet, status);
 }
 
 /// Calls run<float>(o) or run<double>(o) by the --precision option and turns a sphere::error

@@ -93,7 +93,12 @@ int run(const options& o)
     // that the load step meets a stiffer, nearly elastic skeleton, Terzaghi's assumption.
     if (o.preload > 0) {
         sim.set_wall_control(5, granular::stress_wall(o.sample, sim, o.preload));
-        sim.run(std::size_t(std::ceil(o.preload_time / double(sim.dt()))));
+        granular::run_steps<Sim>(sim, "preload", std::size_t(std::ceil(o.preload_time / double(sim.dt()))),
+                                 o.sample.quiet, [](const Sim& s) {
+                                     char text[64];
+                                     std::snprintf(text, sizeof text, "wall z = %.6f m", s.walls().face[5].position);
+                                     return std::string(text);
+                                 });
     }
     const world<Real> box = sim.config().box;
     const double z_bottom = sim.walls().face[4].position;
