@@ -3,7 +3,9 @@ configures the project in a build folder with only the package switched on, buil
 module sphere._sphere (target sphere_python) and installs it with the package's Python files
 (python/sphere/). CMAKE_ARGS adds CMake options, e.g. CMAKE_ARGS=-DSPHERE_NATIVE=ON for code
 tuned to this machine's CPU (off by default: a wheel may run elsewhere). Needs cmake, a C++17
-compiler, OpenMP, the Thrust headers and pybind11 (docs/python.md)."""
+compiler, OpenMP, the Thrust headers and pybind11; libpng's development files (Debian's
+libpng-dev) when found give the pictures (Simulation.render: the module then links libpng),
+without them the package builds without pictures (docs/python.md)."""
 
 import os
 import re
@@ -35,8 +37,8 @@ class CMakeBuild(build_ext):
                         "-DSPHERE_ENABLE_CUDA=OFF", "-DSPHERE_NATIVE=OFF", "-DSPHERE_BUILD_PYTHON=ON",
                         f"-DSPHERE_PYTHON={sys.executable}", f"-Dpybind11_DIR={pybind11.get_cmake_dir()}",
                         *os.environ.get("CMAKE_ARGS", "").split()], check=True)
-        # Three translation units: more jobs than that do not help.
-        jobs = os.environ.get("CMAKE_BUILD_PARALLEL_LEVEL") or str(min(3, os.cpu_count() or 1))
+        # Four translation units: more jobs than that do not help.
+        jobs = os.environ.get("CMAKE_BUILD_PARALLEL_LEVEL") or str(min(4, os.cpu_count() or 1))
         subprocess.run(["cmake", "--build", str(build), "--target", "sphere_python", "--parallel", jobs], check=True)
         built = next((build / "python" / "sphere").glob("_sphere.*"))
         destination = Path(self.get_ext_fullpath(ext.name))

@@ -2,8 +2,9 @@
 # docs/python.md). Each tests/python/test_*.py is one test, python_<name>, run by
 # `${SPHERE_PYTHON} -m pytest` (Debian's python3-pytest, for /usr/bin/python3) with the build's
 # package folder on PYTHONPATH and one OpenMP thread, like the C++ tests. The comparisons with
-# the C++ examples (test_checkpoint.py, test_consolidation.py, test_shear.py) run them from
-# SPHERE_CONSOLIDATION and SPHERE_SHEAR, test_program.py the sphere program from SPHERE_PROGRAM
+# the C++ examples (test_checkpoint.py, test_consolidation.py, test_shear.py,
+# test_experiments.py) run them from SPHERE_CONSOLIDATION, SPHERE_SHEAR, SPHERE_UNIAXIAL and
+# SPHERE_TRIAXIAL, test_program.py the sphere program from SPHERE_PROGRAM
 # (the package's run_program finds it there too); without them those tests are skipped. test_pip_install.py builds the
 # package again with pip: label slow. Nothing is registered when the package is not built
 # (SPHERE_BUILD_PYTHON OFF).
@@ -21,6 +22,12 @@ if(TARGET consolidation)
 endif()
 if(TARGET shear)
     list(APPEND _sphere_python_environment "SPHERE_SHEAR=$<TARGET_FILE:shear>")
+endif()
+if(TARGET uniaxial)
+    list(APPEND _sphere_python_environment "SPHERE_UNIAXIAL=$<TARGET_FILE:uniaxial>")
+endif()
+if(TARGET triaxial)
+    list(APPEND _sphere_python_environment "SPHERE_TRIAXIAL=$<TARGET_FILE:triaxial>")
 endif()
 if(TARGET sphere_program)
     list(APPEND _sphere_python_environment "SPHERE_PROGRAM=$<TARGET_FILE:sphere_program>")

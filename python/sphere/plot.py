@@ -1,8 +1,8 @@
 """Figures of sphere's results with matplotlib (the Agg backend: no display needed): the energy
-budget, the walls, a shear test, a rose diagram and a porosity profile. Each function draws on
-a new matplotlib Figure, saves it to `path` (PNG, or any format matplotlib writes, by the
-extension) when given, and returns the Figure. Import it as sphere.plot (matplotlib is loaded
-only then)."""
+budget, the walls, a shear test, a triaxial test's stress path, a uniaxial test, a rose diagram
+and a porosity profile. Each function draws on a new matplotlib Figure, saves it to `path`
+(PNG, or any format matplotlib writes, by the extension) when given, and returns the Figure.
+Import it as sphere.plot (matplotlib is loaded only then)."""
 
 import os
 
@@ -15,6 +15,8 @@ from .record import Recorder
 from .settings import FACES
 from .shear import Shear, ShearSeries
 from .simulation import Simulation
+from .triaxial import Triaxial, TriaxialSeries
+from .uniaxial import Uniaxial, UniaxialSeries
 
 ENERGY_TERMS = ["kinetic", "rotational", "potential", "elastic", "dissipated_viscous", "dissipated_friction",
                 "boundary_work", "total"]
@@ -93,6 +95,46 @@ def shear(result, path=None):
     axes[2].plot(series.strain, series.dilation)
     axes[2].set_ylabel("dilation (m)")
     axes[2].set_xlabel("shear strain")
+    return _finish(fig, path)
+
+
+def triaxial(result, path=None):
+    """A triaxial test (a sphere.Triaxial or its TriaxialSeries): the stress path, deviatoric
+    stress q against mean stress p (Pa), over both phases (the isotropic one dashed); and the
+    stress ratio q/p against axial strain in the axial compression."""
+    series = result.series if isinstance(result, Triaxial) else result
+    if not isinstance(series, TriaxialSeries):
+        raise _wrong("triaxial", result, "a sphere.Triaxial or sphere.TriaxialSeries")
+    fig = Figure(figsize=(10, 5), layout="constrained")
+    path_ax, ratio_ax = fig.subplots(1, 2)
+    iso, axial = ~series.axial, series.axial
+    path_ax.plot(series.mean_stress[iso], series.deviatoric_stress[iso], "--o", markersize=3, label="isotropic")
+    path_ax.plot(series.mean_stress[axial], series.deviatoric_stress[axial], "-o", markersize=3,
+                 label="axial compression")
+    path_ax.set_xlabel("mean stress p (Pa)")
+    path_ax.set_ylabel("deviatoric stress q (Pa)")
+    path_ax.legend(fontsize=7)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = series.deviatoric_stress[axial] / series.mean_stress[axial]
+    ratio_ax.plot(series.axial_strain[axial], ratio, "-o", markersize=3)
+    ratio_ax.set_xlabel("axial strain")
+    ratio_ax.set_ylabel("q / p")
+    return _finish(fig, path)
+
+
+def uniaxial(result, path=None):
+    """A uniaxial test (a sphere.Uniaxial or its UniaxialSeries): axial stress (Pa) and porosity
+    against axial strain."""
+    series = result.series if isinstance(result, Uniaxial) else result
+    if not isinstance(series, UniaxialSeries):
+        raise _wrong("uniaxial", result, "a sphere.Uniaxial or sphere.UniaxialSeries")
+    fig = Figure(figsize=(8, 7), layout="constrained")
+    axes = fig.subplots(2, 1, sharex=True)
+    axes[0].plot(series.axial_strain, series.axial_stress, "-o", markersize=3)
+    axes[0].set_ylabel("axial stress (Pa)")
+    axes[1].plot(series.axial_strain, series.porosity, "-o", markersize=3)
+    axes[1].set_ylabel("porosity")
+    axes[1].set_xlabel("axial strain")
     return _finish(fig, path)
 
 

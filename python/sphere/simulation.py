@@ -230,6 +230,19 @@ class Simulation:
         """Writes everything the simulation needs to continue to `path` (atomically)."""
         self._impl.write_checkpoint(os.fspath(path))
 
+    def render(self, path, method="pres", max_val=None, lower_cutoff=0.0):
+        """Writes a picture of the particles to the PNG file `path` (atomically) with the
+        library's ray tracer (sphere::render_png, docs/render.md), as the original sphere's
+        render(): 800 x 800 pixels looking along +y, each particle coloured by `method`:
+        'normal' (one colour), 'pres' (particle pressure, Pa; zeros without the energy audit),
+        'vel' (speed, m/s), 'angvel' (angular speed, rad/s) or 'xdisp' (accumulated x
+        displacement, m), on the jet colour map from `lower_cutoff` to `max_val` (in the
+        method's unit; None: the largest value shown) with a colour bar; particles below
+        `lower_cutoff` are not drawn. The file's text chunks name the method ('sphere field')
+        and the range. Raises sphere.Error for an unknown method, a bad range, a file that
+        cannot be written, or a build without libpng."""
+        _sphere.render_png(self._impl, os.fspath(path), method, max_val, lower_cutoff)
+
 
 def _written_precision(path):
     """The precision a checkpoint was written in ('double' where the header does not say: the

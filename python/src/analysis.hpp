@@ -5,6 +5,7 @@
 // (stress.cuh). The precision-independent orientation and rose histogram (bond_rose.cuh) are
 // bound by bind_orientations.
 #include "common.hpp"
+#include "fields.hpp"
 
 #include <vector>
 
@@ -37,13 +38,7 @@ void bind_analysis(py::module_& m)
     m.def(
         "porosity_in_box",
         [](const Sim& sim, py::handle lo, py::handle hi) {
-            const sphere::porosity_result p = sphere::bulk_porosity(sim, point(lo, "lo"), point(hi, "hi"));
-            py::dict d;
-            d["porosity"] = p.porosity;
-            d["void_ratio"] = p.void_ratio;
-            d["solid_volume"] = p.solid_volume;
-            d["volume"] = p.volume;
-            return d;
+            return porosity_of(sphere::bulk_porosity(sim, point(lo, "lo"), point(hi, "hi")));
         },
         py::arg("simulation"), py::arg("lo"), py::arg("hi"));
     m.def(

@@ -141,4 +141,15 @@ py::dict energy_of(const sphere::energy_budget<Real>& e)
     return d;
 }
 
+/// A porosity result: porosity, void ratio, the solid and the whole volume (m^3).
+inline py::dict porosity_of(const sphere::porosity_result& p)
+{
+    py::dict d;
+    d["porosity"] = p.porosity;
+    d["void_ratio"] = p.void_ratio;
+    d["solid_volume"] = p.solid_volume;
+    d["volume"] = p.volume;
+    return d;
+}
+
 } // namespace sphere_python

@@ -1,7 +1,11 @@
 // The extension module sphere._sphere (docs/python.md): the library's error as sphere.Error,
 // the project's version, the precision-independent helpers and a submodule per precision
-// (float.cpp, double.cpp).
+// (float.cpp, double.cpp), and the pictures (render.cpp).
 #include "analysis.hpp"
+
+namespace sphere_python {
+void bind_render(py::module_& m); // render.cpp
+} // namespace sphere_python
 
 PYBIND11_MODULE(_sphere, m)
 {
@@ -21,4 +25,5 @@ PYBIND11_MODULE(_sphere, m)
     sphere_python::bind_orientations(m);
     sphere_python::bind_float(m);
     sphere_python::bind_double(m);
+    sphere_python::bind_render(m);
 }

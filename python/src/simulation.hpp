@@ -71,16 +71,7 @@ void bind_simulation(py::module_& m)
              })
         .def("energy", [](const Sim& s) { return energy_of(s.energy()); })
         .def("momentum", [](const Sim& s) { return tuple3(s.momentum()); })
-        .def("porosity",
-             [](const Sim& s) {
-                 const sphere::porosity_result p = sphere::bulk_porosity(s);
-                 py::dict d;
-                 d["porosity"] = p.porosity;
-                 d["void_ratio"] = p.void_ratio;
-                 d["solid_volume"] = p.solid_volume;
-                 d["volume"] = p.volume;
-                 return d;
-             })
+        .def("porosity", [](const Sim& s) { return porosity_of(sphere::bulk_porosity(s)); })
         .def("wall_normal_stress", [](const Sim& s, int face) { return sphere::wall_normal_stress(s, face); },
              py::arg("face"))
         .def(

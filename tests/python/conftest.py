@@ -1,8 +1,8 @@
 """Shared by the tests of the Python package sphere. tests/python_tests.cmake runs each test file
 with /usr/bin/python3 -m pytest, PYTHONPATH at the build's package folder (build/python),
-OMP_NUM_THREADS=1, SPHERE_SOURCE_DIR at the repository, SPHERE_CONSOLIDATION and SPHERE_SHEAR at
-the C++ consolidation and shear examples and SPHERE_PROGRAM at the sphere program (each unset
-when it is not built: the tests that run it are skipped then)."""
+OMP_NUM_THREADS=1, SPHERE_SOURCE_DIR at the repository, SPHERE_CONSOLIDATION, SPHERE_SHEAR,
+SPHERE_UNIAXIAL and SPHERE_TRIAXIAL at the C++ examples and SPHERE_PROGRAM at the sphere program
+(each unset when it is not built: the tests that run it are skipped then)."""
 
 import os
 import subprocess

@@ -1,6 +1,6 @@
 """`pip install .` builds and installs the package (setup.py, the project's CMake): installed
 into a fresh folder from a copy of the sources (so that pip's build folders stay out of the
-checkout), it imports from there and runs. Slow: it compiles the extension module again."""
+checkout), it imports from there, runs and renders a picture (libpng linked). Slow: it compiles the extension module again."""
 
 import os
 import shutil
@@ -19,6 +19,12 @@ s = sphere.Settings(gravity=(0, 0, -9.81), contact=contact, wall=contact)
 sim = sphere.Simulation(s, [[0.5, 0.5, 0.5]], 0.01, 2500, precision="float")
 sim.run(100)
 print(sim.steps, float(sim.snapshot().positions[0, 2]) < 0.5)
+if sphere._sphere.has_png:  # libpng linked where the build found it
+    sim.render("picture.png", method="vel")
+    with open("picture.png", "rb") as f:
+        print(f.read(4)[1:] == b"PNG")  # the PNG signature
+else:
+    print("no libpng")
 """
 
 
@@ -37,9 +43,11 @@ def test_pip_install(tmp_path):
     env = dict(os.environ, PYTHONPATH=str(target))
     done = subprocess.run([sys.executable, "-c", CHECK], env=env, cwd=tmp_path, capture_output=True, text=True)
     assert done.returncode == 0, done.stderr
-    where, version, run = done.stdout.splitlines()
+    where, version, run, picture = done.stdout.splitlines()
     assert Path(where).parent == target / "sphere"
     import sphere
 
     assert version == sphere.__version__
     assert run == "100 True"
+    # libpng as in the build under test (the same machine finds the same libraries).
+    assert picture == ("True" if sphere._sphere.has_png else "no libpng")

@@ -75,3 +75,34 @@ def test_wrong_arguments(loaded):
         sphere.plot.shear([1, 2])
     with pytest.raises(sphere.Error, match=r"plot.energy: dict given"):
         sphere.plot.energy({})
+
+
+def triaxial_series():
+    """A made-up stress path: three isotropic rows at q = 0, then q growing with the strain."""
+    axial = np.array([False, False, False, True, True, True])
+    strain = np.where(axial, [0, 0, 0, 0.01, 0.02, 0.03], np.nan)
+    sigma_3 = np.full(6, 1e4)
+    sigma_1 = np.array([0.5e4, 0.9e4, 1e4, 1.5e4, 2e4, 2.4e4])
+    q, p = sigma_1 - sigma_3, (sigma_1 + 2 * sigma_3) / 3
+    return sphere.TriaxialSeries(np.linspace(0, 0.05, 6), axial, strain, strain / 2, sigma_1, sigma_3, q, p,
+                                 np.full(6, 0.4), np.full(6, 0.4 / 0.6))
+
+
+def test_triaxial_and_uniaxial_figures(tmp_path):
+    series = triaxial_series()
+    fig = sphere.plot.triaxial(series, tmp_path / "triaxial.png")
+    written(tmp_path / "triaxial.png", fig)
+    path_ax, ratio_ax = fig.axes
+    iso, axial = path_ax.lines
+    assert np.array_equal(iso.get_xdata(), series.mean_stress[:3])
+    assert np.array_equal(iso.get_ydata(), series.deviatoric_stress[:3])
+    assert np.array_equal(axial.get_xdata(), series.mean_stress[3:])
+    assert np.array_equal(ratio_ax.lines[0].get_xdata(), [0.01, 0.02, 0.03])
+    assert np.array_equal(ratio_ax.lines[0].get_ydata(), series.deviatoric_stress[3:] / series.mean_stress[3:])
+    assert path_ax.get_xlabel() == "mean stress p (Pa)" and ratio_ax.get_ylabel() == "q / p"
+
+    u = sphere.UniaxialSeries(*(np.linspace(0, 1, 4) + k for k in range(5)))
+    written(tmp_path / "uniaxial.png", sphere.plot.uniaxial(u, tmp_path / "uniaxial.png"))
+    with pytest.raises(sphere.Error, match=r"plot.triaxial: UniaxialSeries given; a sphere.Triaxial or "
+                                           r"sphere.TriaxialSeries is needed"):
+        sphere.plot.triaxial(u)
