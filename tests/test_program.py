@@ -106,7 +106,8 @@ def killed_and_resumed(tag, *options):
     for n in names:
         with open(os.path.join(whole, n), "rb") as a, open(os.path.join(broken, n), "rb") as b:
             check(a.read() == b.read(), f"{tag}: {n} equals the uninterrupted run's")
-    again = run(*args, "-o", broken)
+    # Started again, with the input named another way: the same run (its checksum), finished.
+    again = run(os.path.join(SCRATCH, ".", "input.ck"), *args[1:], "-o", broken)
     check(f"resuming from output {outputs - 1} " in again.stdout, f"{tag}: a finished run started again does nothing more")
     return whole
 

@@ -123,10 +123,12 @@ struct run_status {
     }
 
     /// The first entry of `identity` whose value differs from `other`'s (or is missing there),
-    /// as "key: here vs there"; empty when both identify the same run.
+    /// as "key value-there there, value-here here"; empty when both identify the same run. The
+    /// input's path is not compared (the same file may be named another way): its checksum is.
     std::string difference(const run_status& other) const
     {
         for (const auto& [key, value] : identity) {
+            if (key == "input") continue;
             std::string theirs = "(none)";
             for (const auto& [k, v] : other.identity)
                 if (k == key) theirs = v;
