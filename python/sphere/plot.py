@@ -1,6 +1,7 @@
 """Figures of sphere's results with matplotlib (the Agg backend: no display needed): the energy
-budget, the walls, a shear test, a triaxial test's stress path, a uniaxial test, a rose diagram
-and a porosity profile. Each function draws on a new matplotlib Figure, saves it to `path`
+budget, the walls, a shear test, a triaxial test's stress path, a uniaxial test, a rose diagram,
+a porosity profile, the pore fluid's pressure and velocity profiles and its pressure solver's
+convergence. Each function draws on a new matplotlib Figure, saves it to `path`
 (PNG, or any format matplotlib writes, by the extension) when given, and returns the Figure.
 Import it as sphere.plot (matplotlib is loaded only then)."""
 
@@ -10,6 +11,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from ._sphere import Error
+from .fluid import Fluid
 from .analysis import PorosityProfile, Rose, contact_rose, porosity_profile as _profile
 from .record import Recorder
 from .settings import FACES
@@ -172,4 +174,74 @@ def porosity_profile(source, path=None, slices=10):
     ax.plot(np.repeat(source.porosity, 2), z)
     ax.set_xlabel("porosity")
     ax.set_ylabel("height z (m)")
+    return _finish(fig, path)
+
+
+def _fluid(what, fluid):
+    if not isinstance(fluid, Fluid):
+        raise _wrong(what, fluid, "a sphere.Fluid")
+    return fluid
+
+
+def fluid_pressure(fluid, path=None):
+    """The pore pressure (Pa) of a sphere.Fluid against height z (m): the mean of each cell
+    layer, its least and largest cell, and, when the top holds a prescribed pressure, the
+    hydrostatic pressure (dashed) and the excess over it (right)."""
+    p = _fluid("fluid_pressure", fluid).pressure()
+    z = fluid.centres()
+    hydrostatic = fluid.hydrostatic()
+    fig = Figure(figsize=(9 if hydrostatic is not None else 5, 7), layout="constrained")
+    axes = fig.subplots(1, 2 if hydrostatic is not None else 1, sharey=True, squeeze=False)[0]
+    axes[0].plot(Fluid.profile(p), z, label="layer mean")
+    axes[0].fill_betweenx(z, p.min(axis=(0, 1)), p.max(axis=(0, 1)), alpha=0.3, label="least to largest cell")
+    if hydrostatic is not None:
+        axes[0].plot(hydrostatic, z, "--", label="hydrostatic")
+        axes[1].plot(Fluid.profile(p) - hydrostatic, z)
+        axes[1].set_xlabel("excess pressure (Pa)")
+    axes[0].set_xlabel("pressure (Pa)")
+    axes[0].set_ylabel("height z (m)")
+    axes[0].legend(fontsize=7)
+    fig.suptitle(f"pore pressure at t = {fluid.time:.4g} s")
+    return _finish(fig, path)
+
+
+def fluid_velocity(fluid, path=None):
+    """The flow of a sphere.Fluid against height z (m): the layer means of the x, y and z
+    components (m/s) of its velocity (Navier-Stokes) or Darcy flux (Darcy), and of the
+    particles' mean velocity, and the layers' porosity."""
+    v = _fluid("fluid_velocity", fluid).flow()
+    z = fluid.centres()
+    name = "fluid velocity" if fluid.model == "navier_stokes" else "Darcy flux"
+    fig = Figure(figsize=(9, 7), layout="constrained")
+    flow_ax, porosity_ax = fig.subplots(1, 2, sharey=True, width_ratios=[2, 1])
+    mean, particles = Fluid.profile(v), Fluid.profile(fluid.particle_velocity())
+    for a, axis in enumerate("xyz"):
+        line, = flow_ax.plot(mean[:, a], z, label=f"{name} {axis}")
+        flow_ax.plot(particles[:, a], z, ":", color=line.get_color(), label=f"particles {axis}")
+    flow_ax.set_xlabel("velocity (m/s)")
+    flow_ax.set_ylabel("height z (m)")
+    flow_ax.legend(fontsize=7)
+    porosity_ax.plot(Fluid.profile(fluid.porosity()), z)
+    porosity_ax.set_xlabel("porosity")
+    fig.suptitle(f"{name} at t = {fluid.time:.4g} s")
+    return _finish(fig, path)
+
+
+def solver_convergence(fluid, path=None):
+    """The pressure solver of a sphere.Fluid against time (s): the iterations of each coupled
+    step's solve (the steps this Fluid object took) and the residual it stopped at (the
+    criterion's value, with the tolerance dashed; steps that did not converge marked)."""
+    history = _fluid("solver_convergence", fluid).solver_history
+    fig = Figure(figsize=(8, 6), layout="constrained")
+    iterations_ax, residual_ax = fig.subplots(2, 1, sharex=True)
+    iterations_ax.plot(history.time, history.iterations, "-o", markersize=3)
+    iterations_ax.set_ylabel("iterations")
+    residual_ax.semilogy(history.time, np.maximum(history.residual, np.finfo(float).tiny), "-o", markersize=3)
+    failed = ~history.converged
+    if failed.any():
+        residual_ax.semilogy(history.time[failed], history.residual[failed], "rx", label="not converged")
+        residual_ax.legend(fontsize=7)
+    residual_ax.axhline(fluid.settings.tolerance, linestyle="--", color="gray")
+    residual_ax.set_ylabel("residual")
+    residual_ax.set_xlabel("time (s)")
     return _finish(fig, path)

@@ -111,3 +111,64 @@ class Settings:
     reorder: bool = True
     pair_summation: str = "automatic"
     walls: list = field(default_factory=_fixed_walls)
+
+
+@dataclass
+class FluidBoundary:
+    """One z end of the fluid grid (``sphere::fluid_boundary``).
+
+    kind: 'no_flow' (an impermeable, free-slip wall at the grid's face), 'pressure' (the
+        pressure pressure + amplitude sin(2 pi frequency t + phase), Pa, held at the centres of
+        the outermost cell layer: drained) or 'inflow' (the superficial velocity ``velocity``,
+        m/s along +z, through the grid's face; the other end must be 'pressure').
+    """
+
+    kind: str = "no_flow"
+    pressure: float = 0.0
+    amplitude: float = 0.0
+    frequency: float = 0.0
+    phase: float = 0.0
+    velocity: float = 0.0
+
+
+@dataclass
+class FluidSettings:
+    """The pore fluid and its coupling to the particles (``sphere::fluid_params``,
+    ``sphere::darcy_params``, ``sphere::coupling_options``; docs/fluid.md).
+
+    model: 'navier_stokes' (the porosity-weighted Navier-Stokes equations, with the Gidaspow
+        drag law) or 'darcy' (the pore pressure alone, Darcy's law with Kozeny-Carman
+        permeability).
+    solver: the pressure solver, 'mg' (conjugate gradients with a multigrid preconditioner) or
+        'cg' (plain conjugate gradients).
+    density (kg/m^3), viscosity (Pa s): water at 25 C by default.
+    beta: weight of the old pressure in the projection, 0 (Chorin) to 1 (Navier-Stokes).
+    gravity: (m/s^2); None takes the simulation's.
+    bottom, top: FluidBoundary of the z = lo and z = hi ends.
+    tolerance, max_iterations, criterion: the pressure solve's ('relative_residual' or
+        'normalized_change'); use a tolerance near 1e-4 in float.
+    compressibility (1/Pa), permeability_prefactor (m^2, k_c of k = k_c phi^3 / (1 - phi)^2:
+        d^2/180 for spheres of diameter d; no default), max_porosity: the Darcy model's.
+    dem_steps: DEM steps per fluid step (the fluid step is dem_steps times the DEM step).
+    pressure_force: apply -V grad p to the particles (buoyancy and the pressure gradient).
+    porosity: how the cells' solid volume is measured, 'cell_volume' (conserves it) or
+        'cell_sphere' (the original's estimator).
+    """
+
+    model: str = "navier_stokes"
+    solver: str = "mg"
+    density: float = 997.05
+    viscosity: float = 8.90e-4
+    beta: float = 0.0
+    gravity: tuple = None
+    bottom: FluidBoundary = field(default_factory=FluidBoundary)
+    top: FluidBoundary = field(default_factory=FluidBoundary)
+    tolerance: float = 1e-8
+    max_iterations: int = 100000
+    criterion: str = "relative_residual"
+    compressibility: float = 4.5e-10
+    permeability_prefactor: float = 0.0
+    max_porosity: float = 0.9
+    dem_steps: int = 10
+    pressure_force: bool = True
+    porosity: str = "cell_volume"

@@ -1,0 +1,198 @@
+"""The pore fluid from Python (sphere.Fluid): hydrostatic pressure (Navier-Stokes) and steady
+Darcy flow through a fixed bed against their closed forms, the grid's fields as arrays, a
+coupled run restarted from a checkpoint continuing bit for bit, the figures, and the errors."""
+
+import math
+
+import numpy as np
+import pytest
+
+import sphere
+from conftest import linear_settings
+
+G = 9.81
+SPACING, RADIUS = 0.005, 0.002
+
+
+def lattice_bed(precision, layers=8, fixed=True, dt=1e-4):
+    """A simple cubic lattice of 4 x 4 x `layers` spheres (spacing 5 mm, radius 2 mm, from the
+    bottom) in a 20 x 20 x 60 mm box periodic in x and y: with 10 mm cells every cell of a layer
+    holds the same solid."""
+    x = (np.arange(4) + 0.5) * SPACING
+    z = (np.arange(layers) + 0.5) * SPACING
+    positions = np.array([[a, b, c] for c in z for b in x for a in x])
+    s = linear_settings(hi=(0.02, 0.02, 0.06), k_n=1.0, boundary=("periodic", "periodic", "wall"), gravity=(0, 0, -G),
+                        dt=dt)
+    return sphere.Simulation(s, positions, RADIUS, 2600, fixed=np.full(len(positions), fixed), precision=precision)
+
+
+def tolerance(precision):
+    return 1e-11 if precision == "double" else 1e-5
+
+
+def test_hydrostatic_pressure_around_a_fixed_bed(precision):
+    sim = lattice_bed(precision)
+    fluid = sphere.Fluid(sim, (2, 2, 6), sphere.FluidSettings(
+        density=1000, viscosity=1e-3, top=sphere.FluidBoundary("pressure", pressure=250.0),
+        tolerance=tolerance(precision), dem_steps=10))
+    assert fluid.settings.gravity == pytest.approx((0, 0, -G))  # the simulation's
+    assert fluid.cells == (2, 2, 6) and fluid.model == "navier_stokes"
+    assert np.allclose(fluid.cell_width, (0.01, 0.01, 0.01))
+    assert np.allclose(fluid.centres(), np.arange(6) * 0.01 + 0.005)
+    # The particles' buoyancy -V grad p reaches the fluid a step late (explicit coupling): in a
+    # layer of porosity phi the gradient approaches rho g by the factor 1 - phi (0.27) per step.
+    fluid.step(30)
+    assert fluid.time == pytest.approx(30 * 10 * sim.dt) and sim.steps == 300
+    p = fluid.pressure()
+    assert p.shape == (2, 2, 6)
+    # p = p_top + rho g (z_top - z), z_top the top layer's centre: 250 Pa + 98.1 Pa per cm.
+    expected = 250.0 + 1000 * G * (0.055 - fluid.centres())
+    scale = 1e-9 if precision == "double" else 2e-5
+    assert np.allclose(p, expected[None, None, :], rtol=0, atol=scale * expected.max())
+    profile = sphere.Fluid.profile(p)
+    assert profile.shape == (6,)
+    assert np.allclose(profile, expected, rtol=0, atol=scale * expected.max())
+    # (in float the grid's box and g are the float values)
+    assert np.allclose(fluid.hydrostatic(), expected, rtol=1e-14 if precision == "double" else 1e-6, atol=0)
+    # At rest: the velocity is the round-off of the projection.
+    assert np.abs(fluid.velocity()).max() < (1e-12 if precision == "double" else 1e-6)
+    # The bed: 2 x 2 x 2 spheres per cell in the four lower layers, none above.
+    solid = 8 * 4 / 3 * math.pi * RADIUS**3 / 1e-6
+    phi = fluid.porosity()
+    assert np.allclose(phi[:, :, :4], 1 - solid, rtol=1e-5) and np.all(phi[:, :, 4:] == 1)
+    assert np.allclose(fluid.particle_diameter()[:, :, :4], 2 * RADIUS, rtol=1e-5)
+    assert np.all(fluid.particle_velocity() == 0)
+    history = fluid.solver_history
+    assert len(history.time) == 30 and history.converged.all()
+    assert np.all(history.residual <= tolerance(precision))
+    assert fluid.last_solve()["iterations"] == history.iterations[-1]
+    assert fluid.stable_time_step() > fluid.dt
+
+
+def test_steady_darcy_flow_through_a_fixed_bed(precision):
+    # Inflow U at the bottom, p = 0 on the top layer, no gravity: in steady state q_z = U on every
+    # face, and Darcy's law (D-2) over the face between layers k and k+1, with the harmonic mean
+    # of their conductivities, gives p_k - p_k+1 = U h (1/K_k + 1/K_k+1) / 2.
+    sim = lattice_bed(precision)
+    sim_settings = sim.settings
+    assert sim_settings.gravity == pytest.approx((0, 0, -G))
+    U, d = 1e-4, 2 * RADIUS
+    fluid = sphere.Fluid(sim, (2, 2, 6), sphere.FluidSettings(
+        model="darcy", solver="cg", viscosity=1e-3, gravity=(0, 0, 0), permeability_prefactor=d * d / 180,
+        bottom=sphere.FluidBoundary("inflow", velocity=U), top=sphere.FluidBoundary("pressure"),
+        tolerance=tolerance(precision), dem_steps=10))
+    fluid.step(20)
+    K = fluid.conductivity()
+    phi = fluid.porosity()
+    assert np.allclose(K, d * d / 180 * np.minimum(phi, 0.9) ** 3 / (1 - np.minimum(phi, 0.9)) ** 2 / 1e-3,
+                       rtol=1e-5)
+    p = sphere.Fluid.profile(fluid.pressure())
+    k_layers = sphere.Fluid.profile(K)
+    h = fluid.cell_width[2]
+    drop = U * h * (1 / k_layers[:-1] + 1 / k_layers[1:]) / 2
+    rtol = 1e-7 if precision == "double" else 2e-3
+    assert np.allclose(p[:-1] - p[1:], drop, rtol=rtol)
+    assert p[-1] == 0
+    q = fluid.darcy_flux()
+    # Inner layers: the mean of the two face fluxes, U; every column alike.
+    assert np.allclose(q[:, :, 1:-1, 2], U, rtol=rtol) and np.allclose(q[:, :, :, :2], 0, atol=rtol * U)
+    with pytest.raises(sphere.Error, match="fluid.velocity: the navier_stokes model's field; this fluid is darcy"):
+        fluid.velocity()
+    assert np.array_equal(fluid.flow(), q)
+    assert fluid.stable_time_step() == math.inf
+
+
+@pytest.mark.parametrize("model", ["navier_stokes", "darcy"])
+def test_a_coupled_run_continues_from_its_checkpoint_bit_for_bit(precision, model, tmp_path):
+    def coupled():
+        sim = lattice_bed(precision, layers=3, fixed=False, dt=0.0)
+        settings = sphere.FluidSettings(model=model, viscosity=1e-3, top=sphere.FluidBoundary("pressure"),
+                                        permeability_prefactor=(2 * RADIUS) ** 2 / 180,
+                                        tolerance=tolerance(precision), dem_steps=10)
+        return sim, settings
+
+    sim, settings = coupled()
+    fluid = sphere.Fluid(sim, (2, 2, 6), settings)
+    fluid.step(3)
+    path = tmp_path / "coupled.ck"
+    fluid.write_checkpoint(path)
+    fluid.step(3)
+
+    again = sphere.read_checkpoint(path)
+    assert again.precision == precision
+    restored = sphere.Fluid(again, (2, 2, 6), settings)
+    restored.restore(path)
+    assert restored.time == pytest.approx(fluid.time - 3 * fluid.dt)
+    restored.step(3)
+    assert again.steps == sim.steps and again.time == sim.time
+    a, b = sim.snapshot(), again.snapshot()
+    assert np.array_equal(a.positions, b.positions) and np.array_equal(a.velocities, b.velocities)
+    assert np.array_equal(fluid.pressure(), restored.pressure())
+    assert np.array_equal(fluid.flow(), restored.flow())
+    assert fluid.work_on_particles() == restored.work_on_particles()
+    # The particles fell through the fluid: the drag did work against them.
+    assert a.positions[:, 2].max() < 2.5 * SPACING and fluid.work_on_particles() < 0
+
+    # A checkpoint without a fluid section, and a fluid of another grid.
+    plain = tmp_path / "plain.ck"
+    sim.write_checkpoint(plain)
+    with pytest.raises(sphere.Error, match="no fluid section"):
+        sphere.Fluid(again, (2, 2, 6), settings).restore(plain)
+    with pytest.raises(sphere.Error, match="grid has 2 x 2 x 6 cells, this one 2 x 2 x 5"):
+        sphere.Fluid(again, (2, 2, 5), settings).restore(path)
+
+
+def test_figures_show_the_profiles_and_the_solves(tmp_path):
+    plot = pytest.importorskip("sphere.plot")
+    sim = lattice_bed("double")
+    fluid = sphere.Fluid(sim, (2, 2, 6), sphere.FluidSettings(density=1000, top=sphere.FluidBoundary("pressure")))
+    fluid.step(3)
+    fig = plot.fluid_pressure(fluid, tmp_path / "pressure.png")
+    assert (tmp_path / "pressure.png").stat().st_size > 0
+    mean = fig.axes[0].lines[0]
+    assert np.array_equal(mean.get_xdata(), sphere.Fluid.profile(fluid.pressure()))
+    assert np.array_equal(mean.get_ydata(), fluid.centres())
+    assert np.array_equal(fig.axes[0].lines[1].get_xdata(), fluid.hydrostatic())
+    fig = plot.fluid_velocity(fluid, tmp_path / "velocity.png")
+    assert (tmp_path / "velocity.png").stat().st_size > 0
+    assert np.array_equal(fig.axes[0].lines[4].get_xdata(), sphere.Fluid.profile(fluid.velocity())[:, 2])
+    assert np.array_equal(fig.axes[1].lines[0].get_xdata(), sphere.Fluid.profile(fluid.porosity()))
+    fig = plot.solver_convergence(fluid, tmp_path / "convergence.png")
+    assert (tmp_path / "convergence.png").stat().st_size > 0
+    assert np.array_equal(fig.axes[0].lines[0].get_ydata(), fluid.solver_history.iterations)
+    assert len(fig.axes[0].lines[0].get_xdata()) == 3
+    with pytest.raises(sphere.Error, match="plot.fluid_pressure: Simulation given; a sphere.Fluid is needed"):
+        plot.fluid_pressure(sim)
+
+
+@pytest.mark.parametrize("change, message", [
+    (dict(model="lattice_boltzmann"), "fluid.model = 'lattice_boltzmann': not one of 'navier_stokes', 'darcy'"),
+    (dict(solver="jacobi"), "fluid.solver = 'jacobi': not one of 'mg', 'cg'"),
+    (dict(viscosity=-1.0), "fluid: viscosity = -1 Pa s must be positive and finite"),
+    (dict(bottom=sphere.FluidBoundary("inflow", velocity=1e-3)), "an inflow bottom .* needs a prescribed pressure"),
+    (dict(top=sphere.FluidBoundary("drain")), "fluid.top.kind = 'drain': not one of 'no_flow', 'pressure', 'inflow'"),
+    (dict(dem_steps=0), "fluid.dem_steps = 0: a whole number from 1"),
+    (dict(criterion="exact"), "fluid.criterion = 'exact'"),
+    (dict(porosity="voronoi"), "fluid.porosity = 'voronoi'"),
+    (dict(model="darcy"), "darcy: permeability_prefactor = 0 m\\^2 must be positive"),
+])
+def test_bad_fluid_settings_are_named(change, message):
+    sim = lattice_bed("double")
+    with pytest.raises(sphere.Error, match=message):
+        sphere.Fluid(sim, (2, 2, 6), sphere.FluidSettings(**change))
+
+
+def test_bad_grids_and_fields_of_the_other_model_are_named():
+    sim = lattice_bed("double")
+    with pytest.raises(sphere.Error, match="fluid: cells = 8: three whole numbers"):
+        sphere.Fluid(sim, 8, None)
+    with pytest.raises(sphere.Error, match="fluid: cells\\[2\\] = 2.5 is not a whole number"):
+        sphere.Fluid(sim, (2, 2, 2.5))
+    with pytest.raises(sphere.Error, match="fluid_grid|cells"):
+        sphere.Fluid(sim, (2, 0, 6))
+    fluid = sphere.Fluid(sim, (2, 2, 6))
+    for field in ("darcy_flux", "conductivity"):
+        with pytest.raises(sphere.Error, match=f"fluid.{field}: the darcy model's field; this fluid is navier_stokes"):
+            getattr(fluid, field)()
+    with pytest.raises(TypeError, match="a sphere.Simulation is needed"):
+        sphere.Fluid("sim", (2, 2, 6))
