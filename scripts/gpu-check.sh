@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
-# The GPU check, for a machine with an NVIDIA GPU: builds the CUDA test binary and the CUDA bed
-# benchmark for this GPU in build-gpu/, runs the tests (they print the host-vs-CUDA comparison),
+# The GPU check, for a machine with an NVIDIA GPU: builds the CUDA test binary, the CUDA bed
+# benchmark and the sphere program's CUDA build for this GPU in build-gpu/, runs the tests (they
+# print the host-vs-CUDA comparison) and tests/test_program.py on sphere-cuda (a CUDA run killed
+# and resumed equals an uninterrupted one byte for byte),
 # times bed_cuda on the dense bed at 1e5, 1e6 and 4e6 particles in float, mixed and double, and
 # writes the figures with the date, commit and GPU into a markdown file that
 # docs/performance.md can quote.
@@ -22,12 +24,18 @@ gpu=$(nvidia-smi --query-gpu=name,driver_version --format=csv,noheader 2>/dev/nu
 [[ -f $bed_csv_xz ]] || fail "no $bed_csv_xz (set SPHERE_BED_DIR to the folder of the bed scenario)"
 
 cmake -S . -B build-gpu -DCMAKE_BUILD_TYPE=Release -DSPHERE_ENABLE_CUDA=ON -DCMAKE_CUDA_ARCHITECTURES=native
-cmake --build build-gpu -j "$(nproc)" --target sphere_cuda_tests bed_cuda
+cmake --build build-gpu -j "$(nproc)" --target sphere_cuda_tests bed_cuda sphere_program_cuda consolidation
 
 work=$(mktemp -d); trap 'rm -rf "$work"' EXIT
 tests=passed
 build-gpu/tests/sphere_cuda_tests 2>&1 | tee "$work/tests.log" || tests=FAILED
 grep -q "no CUDA device" "$work/tests.log" && fail "the CUDA runtime finds no device although nvidia-smi lists $gpu"
+
+# The program on the GPU: its input is the consolidation example's checkpoint, as in CTest.
+program=passed
+build-gpu/examples/consolidation -n 150 --time 0.05 --output-interval 0.01 --precision float -q -o "$work/consolidation"
+/usr/bin/python3 tests/test_program.py build-gpu/apps/sphere-cuda "$work/consolidation/checkpoint.ck" "$work/program" \
+    2>&1 | tee "$work/program.log" || program=FAILED
 
 # The 50,000-particle bed is periodic in x and y: tiled 2 x 1, 4 x 5 and 8 x 10 it holds 1e5,
 # 1e6 and 4e6 particles.
@@ -66,6 +74,8 @@ git diff --quiet HEAD || commit="$commit with local changes"
     echo
     grep "^host vs CUDA" "$work/tests.log" || echo "(no host-vs-CUDA comparison line)"
     echo
+    echo "tests/test_program.py on sphere-cuda (--backend cuda killed and resumed): $program ($(tail -n 1 "$work/program.log"))."
+    echo
     echo "Dense bed (bench/bed.cpp built as bed_cuda; ../shared/bench/bed, 200 untimed and 2000 timed steps),"
     echo "the 50,000-particle bed tiled 2 x 1, 4 x 5 and 8 x 10; particle-steps/s:"
     echo
@@ -77,3 +87,4 @@ git diff --quiet HEAD || commit="$commit with local changes"
 } > "$out"
 echo "gpu-check: wrote $out"
 [[ $tests == passed ]] || fail "sphere_cuda_tests failed (above)"
+[[ $program == passed ]] || fail "tests/test_program.py failed on sphere-cuda (above)"

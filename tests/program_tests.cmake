@@ -17,3 +17,18 @@ set_tests_properties(program_sphere PROPERTIES
     FIXTURES_REQUIRED example_consolidation_output
     PASS_REGULAR_EXPRESSION "all checks passed"
     TIMEOUT 600)
+
+# The CUDA build of the program (sphere-cuda): the same checks on its host backend, and its
+# --backend cuda (refused before writing anything without a device; resumed byte for byte with one).
+if(TARGET sphere_program_cuda)
+    add_test(NAME program_sphere_cuda
+        COMMAND "${SPHERE_VTK_PYTHON}" "${CMAKE_CURRENT_LIST_DIR}/test_program.py" $<TARGET_FILE:sphere_program_cuda>
+                "${CMAKE_CURRENT_BINARY_DIR}/example_consolidation/checkpoint.ck"
+                "${CMAKE_CURRENT_BINARY_DIR}/program_sphere_cuda")
+    set_tests_properties(program_sphere_cuda PROPERTIES
+        LABELS "example;cuda"
+        ENVIRONMENT "${SPHERE_TEST_ENVIRONMENT}"
+        FIXTURES_REQUIRED example_consolidation_output
+        PASS_REGULAR_EXPRESSION "all checks passed"
+        TIMEOUT 600)
+endif()

@@ -14,6 +14,9 @@ Usage: test_program.py SPHERE INPUT.ck SCRATCH
 - --dry prints the settings and the plan and writes nothing; --version; bad input (missing,
   truncated and foreign files, a total before the input's time, another run in the folder, the
   CUDA backend in a host build) gives exit status 1 and a message naming the value.
+- The CUDA build (sphere-cuda, whose --version lists the cuda backend) passes the same checks on
+  its host backend; its --backend cuda stops before writing anything where there is no CUDA
+  device, and where there is one its run resumes after SIGKILL byte for byte too.
 """
 import os
 import re
@@ -162,7 +165,20 @@ check("--render: colour not in {" in bad_method.stderr, f"an unknown method is r
 
 # Bad input: exit status 1 and a message that names the value.
 version = run("--version")
-check(re.match(r"sphere \d+\.\d+\.\d+ \(checkpoint format \d+", version.stdout) is not None, "--version")
+check(re.match(r"sphere \d+\.\d+\.\d+ \(checkpoint format \d+, backends: host(, cuda)?\)", version.stdout) is not None,
+      "--version")
+CUDA_BUILD = "backends: host, cuda" in version.stdout
+
+if CUDA_BUILD:
+    probe_dir = os.path.join(SCRATCH, "cuda-probe")
+    probe = subprocess.run([SPHERE, input_ck, "-t", str(t0 + interval), "-q", "--backend", "cuda", "-o", probe_dir],
+                           capture_output=True, text=True, timeout=300)
+    if probe.returncode == 1 and "--backend cuda: no CUDA device (" in probe.stderr:
+        check(not os.path.exists(probe_dir), "--backend cuda without a device writes nothing")
+        print("no CUDA device here: the cuda backend's runs are not checked")
+    else:
+        check(probe.returncode == 0, f"--backend cuda: exit {probe.returncode}\n{probe.stderr}")
+        killed_and_resumed("cuda", "--backend", "cuda")
 
 
 def refused(pattern, *args):
@@ -187,7 +203,9 @@ refused(r"--interval -1 s: must be positive", input_ck, "-t", str(total), "-i", 
 refused(r"--total: the simulated time to run to \(s\) is required", input_ck, "-o", os.path.join(SCRATCH, "none"))
 refused(r"holds another run of 'input' \(last_step \d+ there, \d+ here\): give --fresh",
         input_ck, "-t", str(total + 0.5), "-i", str(interval), "-q", "-o", whole)
-refused(r"--backend cuda: this sphere program was built for the host backend only", input_ck, "-t", "1", "--backend", "cuda")
+if not CUDA_BUILD:
+    refused(r"--backend cuda: this sphere program was built for the host backend only; its CUDA build is sphere-cuda",
+            input_ck, "-t", "1", "--backend", "cuda")
 fresh = run(input_ck, "-t", str(t0 + 0.1), "-i", str(interval), "-q", "--fresh", "-o", whole)
 short_last = int(status(whole)[3][4].split()[1])  # the status file's last_step line
 check(short_last == first + round(0.1 / dt) or short_last == first + round(0.1 / dt) + 1, f"--fresh: the shorter run's last step {short_last}")

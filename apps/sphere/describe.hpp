@@ -30,16 +30,6 @@ std::string describe_params(const Params& p)
     return s.str();
 }
 
-inline const char* wall_mode_name(sphere::wall_mode m)
-{
-    switch (m) {
-    case sphere::wall_mode::fixed: return "fixed";
-    case sphere::wall_mode::velocity: return "velocity";
-    case sphere::wall_mode::stress: return "stress";
-    }
-    return "?";
-}
-
 /// Prints the settings of checkpoint `c` (read from `input`) and the plan of the run on stdout.
 template <class Real, class Law>
 void describe(const std::string& input, const sphere::checkpoint_data<Real, Law>& c, const std::string& run,
@@ -54,8 +44,7 @@ void describe(const std::string& input, const sphere::checkpoint_data<Real, Law>
     std::printf("particles      %zu\n", c.state.particles.size());
     std::printf("world          [%g, %g] x [%g, %g] x [%g, %g] m; x %s, y %s, z %s\n", double(s.box.lo.x),
                 double(s.box.hi.x), double(s.box.lo.y), double(s.box.hi.y), double(s.box.lo.z), double(s.box.hi.z),
-                s.box.periodic(0) ? "periodic" : "walls", s.box.periodic(1) ? "periodic" : "walls",
-                s.box.periodic(2) ? "periodic" : "walls");
+                sphere::name(s.box.axis[0]), sphere::name(s.box.axis[1]), sphere::name(s.box.axis[2]));
     std::printf("gravity        (%g, %g, %g) m/s^2\n", double(s.gravity.x), double(s.gravity.y), double(s.gravity.z));
     std::printf("contacts       %s\n", describe_params(s.contact).c_str());
     std::printf("wall contacts  %s\n", describe_params(s.wall).c_str());
@@ -63,7 +52,7 @@ void describe(const std::string& input, const sphere::checkpoint_data<Real, Law>
         const auto& face = c.state.walls.face[f];
         if (!face.active) continue;
         const auto& w = s.walls[f];
-        std::printf("wall face %d    at %.9g m, %s", f, double(face.position), wall_mode_name(w.mode));
+        std::printf("wall face %d    at %.9g m, %s", f, double(face.position), sphere::name(w.mode));
         if (w.mode == sphere::wall_mode::velocity) std::printf(" %g m/s inwards", double(w.velocity));
         if (w.mode == sphere::wall_mode::stress)
             std::printf(" %g Pa (amplitude %g Pa, %g Hz), mass %g kg", double(w.stress), double(w.amplitude),

@@ -118,13 +118,14 @@ void write_picture(const options& o, const sphere::particle_snapshot<Real>& snap
 #endif
 }
 
-/// Runs the checkpoint with the simulation type Sim (its precision, law and integrator).
+/// Runs the checkpoint (the input file's bytes) with the simulation type Sim (its precision,
+/// law, backend and integrator).
 template <class Sim>
-int run(const options& o, const std::string& run_name)
+int run(const options& o, const std::string& run_name, const std::string& bytes)
 {
     using Real = typename Sim::real_type;
     using Law = typename Sim::law_type;
-    const sphere::checkpoint_data<Real, Law> input = sphere::read_checkpoint<Real, Law>(o.input);
+    const sphere::checkpoint_data<Real, Law> input = sphere::decode_checkpoint<Real, Law>(bytes, o.input);
     if (input.fluid)
         sphere::detail::fail("checkpoint '", o.input, "' holds a pore-fluid section (model ", input.fluid->model,
                              "); the sphere program runs DEM checkpoints only: continue a coupled run from C++ "
@@ -153,7 +154,7 @@ int run(const options& o, const std::string& run_name)
 
     program::run_status status;
     status.identity = {{"input", o.input},
-                       {"input_checksum", program::file_checksum(o.input)},
+                       {"input_checksum", program::checksum_text(bytes)},
                        {"run", run_name},
                        {"first_step", std::to_string(plan.first)},
                        {"last_step", std::to_string(plan.last)},
@@ -226,50 +227,79 @@ int run(const options& o, const std::string& run_name)
 }
 
 /// The simulation type for the options and the checkpoint's precision and law; runs it.
-template <class Precision, class Law>
-int run_integrator(const options& o, const std::string& precision)
+template <class Policy, class Precision, class Law>
+int run_integrator(const options& o, const std::string& precision, const std::string& bytes)
 {
     const std::string law = Law::name();
     if (o.integrator == "verlet")
-        return run<sphere::simulation<Precision, sphere::host, Law, sphere::integrate::velocity_verlet>>(
-            o, law + ", " + precision + ", velocity Verlet, host");
-    return run<sphere::simulation<Precision, sphere::host, Law, sphere::integrate::semi_implicit_euler>>(
-        o, law + ", " + precision + ", semi-implicit Euler, host");
+        return run<sphere::simulation<Precision, Policy, Law, sphere::integrate::velocity_verlet>>(
+            o, law + ", " + precision + ", velocity Verlet, " + o.backend, bytes);
+    return run<sphere::simulation<Precision, Policy, Law, sphere::integrate::semi_implicit_euler>>(
+        o, law + ", " + precision + ", semi-implicit Euler, " + o.backend, bytes);
 }
 
-template <class Law>
-int run_precision(const options& o, const sphere::checkpoint_header& header)
+template <class Policy, class Law>
+int run_precision(const options& o, const sphere::checkpoint_header& header, const std::string& bytes)
 {
     const std::string p = o.precision == "file" ? (header.written_precision == 4 ? "float" : "double") : o.precision;
-    if (p == "float") return run_integrator<float, Law>(o, p);
-    if (p == "mixed") return run_integrator<sphere::mixed, Law>(o, p);
-    return run_integrator<double, Law>(o, p);
+    if (p == "float") return run_integrator<Policy, float, Law>(o, p, bytes);
+    if (p == "mixed") return run_integrator<Policy, sphere::mixed, Law>(o, p, bytes);
+    return run_integrator<Policy, double, Law>(o, p, bytes);
 }
 
-int dispatch(const options& o)
+template <class Policy>
+int run_law(const options& o, const sphere::checkpoint_header& header, const std::string& bytes)
 {
-    if (o.backend == "cuda")
-        sphere::detail::fail("--backend cuda: this sphere program was built for the host backend only");
-    const sphere::checkpoint_header header = sphere::read_checkpoint_header(o.input);
     using linear = sphere::contact::linear<>;
     using hertz = sphere::contact::hertz_mindlin<>;
-    if (header.version < 5 || header.law == linear::name()) return run_precision<linear>(o, header);
-    if (header.law == hertz::name()) return run_precision<hertz>(o, header);
+    if (header.version < 5 || header.law == linear::name()) return run_precision<Policy, linear>(o, header, bytes);
+    if (header.law == hertz::name()) return run_precision<Policy, hertz>(o, header, bytes);
     sphere::detail::fail("checkpoint '", o.input, "': contact law ", header.law, "; the sphere program runs ",
                          linear::name(), " and ", hertz::name(), " (other laws: restart from C++)");
+}
+
+/// Reads the input once (its header checked here, the rest by the run) and runs it on the
+/// backend asked for.
+int dispatch(const options& o)
+{
+#if defined(SPHERE_PROGRAM_CUDA)
+    if (o.backend == "cuda") { // before anything is written
+        int devices = 0;
+        const cudaError_t found = cudaGetDeviceCount(&devices);
+        if (found != cudaSuccess || devices == 0)
+            sphere::detail::fail("--backend cuda: no CUDA device (",
+                                 found != cudaSuccess ? cudaGetErrorString(found) : "none found", ")");
+    }
+#else
+    if (o.backend == "cuda")
+        sphere::detail::fail("--backend cuda: this sphere program was built for the host backend only; its CUDA "
+                             "build is sphere-cuda (docs/program.md)");
+#endif
+    const std::string bytes = sphere::detail::checkpoint_bytes(o.input);
+    sphere::checkpoint_header header;
+    sphere::detail::open_checkpoint(bytes, o.input, header);
+#if defined(SPHERE_PROGRAM_CUDA)
+    if (o.backend == "cuda") return run_law<sphere::cuda>(o, header, bytes);
+#endif
+    return run_law<sphere::host>(o, header, bytes);
 }
 
 } // namespace
 
 int main(int argc, char** argv)
 {
+#if defined(SPHERE_PROGRAM_CUDA)
+    const std::string backends = "host, cuda";
+#else
+    const std::string backends = "host";
+#endif
     options o;
     CLI::App app{"sphere: runs the simulation a checkpoint describes until --total seconds of simulated time, "
                  "writing numbered checkpoints, VTK frames and a status file into the output folder; run again, "
                  "it resumes from the last output"};
     app.set_version_flag("-V,--version", std::string("sphere ") + SPHERE_PROGRAM_VERSION + " (checkpoint format " +
                                              std::to_string(sphere::checkpoint_format_version) +
-                                             ", backends: host)");
+                                             ", backends: " + backends + ")");
     app.add_option("input", o.input, "the checkpoint to run (a .ck file)")->required();
     app.add_option("-o,--out", o.out, "output folder (created)")->capture_default_str();
     app.add_option("-t,--total", o.total, "simulated time to run to (s), counted from the simulation's start");

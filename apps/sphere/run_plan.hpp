@@ -138,11 +138,9 @@ struct run_status {
     }
 };
 
-/// The checksum of a checkpoint file as 16 hex digits (FNV-1a 64 of its bytes, as the file's
-/// own); throws sphere::error naming the file when it cannot be read.
-inline std::string file_checksum(const std::string& path)
+/// The checksum of a checkpoint file's bytes as 16 hex digits (FNV-1a 64, as the file's own).
+inline std::string checksum_text(const std::string& bytes)
 {
-    const std::string bytes = sphere::detail::checkpoint_bytes(path);
     std::ostringstream hex;
     hex << std::hex << std::setw(16) << std::setfill('0') << sphere::detail::fnv1a64(bytes.data(), bytes.size());
     return hex.str();

@@ -31,13 +31,16 @@ const std::vector<std::string>& names_of();
 template <>
 inline const std::vector<std::string>& names_of<sphere::boundary>()
 {
-    static const std::vector<std::string> names{"wall", "periodic"};
+    static const std::vector<std::string> names{sphere::name(sphere::boundary::wall),
+                                                sphere::name(sphere::boundary::periodic)};
     return names;
 }
 template <>
 inline const std::vector<std::string>& names_of<sphere::wall_mode>()
 {
-    static const std::vector<std::string> names{"fixed", "velocity", "stress"};
+    static const std::vector<std::string> names{sphere::name(sphere::wall_mode::fixed),
+                                                sphere::name(sphere::wall_mode::velocity),
+                                                sphere::name(sphere::wall_mode::stress)};
     return names;
 }
 template <>

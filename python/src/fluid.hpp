@@ -7,6 +7,7 @@
 
 #include <sphere/fluid.cuh>
 
+#include <cmath>
 #include <limits>
 #include <memory>
 #include <string>
@@ -35,6 +36,16 @@ inline const std::vector<std::string>& names_of<sphere::porosity_method>()
     return names;
 }
 
+/// A Python number that is a whole number from 1 to 2^32 - 1; a sphere::error naming `where`
+/// for anything else.
+inline unsigned positive_count(py::handle value, const std::string& where)
+{
+    const double v = number(value, where);
+    if (!(v >= 1 && v <= 4294967295.0 && v == double(unsigned(v))))
+        sphere::detail::fail(where, " = ", v, ": a whole number from 1 to 4294967295 is needed");
+    return unsigned(v);
+}
+
 /// sphere.FluidBoundary to one end of the fluid grid.
 template <class Real>
 sphere::fluid_boundary<Real> fluid_boundary_from(py::handle b, const std::string& where)
@@ -61,10 +72,7 @@ sphere::fluid_params<Real> fluid_params_from(py::handle s)
     p.bottom = fluid_boundary_from<Real>(s.attr("bottom"), "fluid.bottom");
     p.top = fluid_boundary_from<Real>(s.attr("top"), "fluid.top");
     p.poisson.tolerance = number(s.attr("tolerance"), "fluid.tolerance");
-    const double iterations = number(s.attr("max_iterations"), "fluid.max_iterations");
-    if (!(iterations >= 1 && iterations <= 4e9 && iterations == double(unsigned(iterations))))
-        sphere::detail::fail("fluid.max_iterations = ", iterations, ": a whole number from 1 to 4e9 is needed");
-    p.poisson.max_iterations = unsigned(iterations);
+    p.poisson.max_iterations = positive_count(s.attr("max_iterations"), "fluid.max_iterations");
     p.poisson.criterion = parse<sphere::poisson_criterion>(s.attr("criterion"), "fluid.criterion");
     return p;
 }
@@ -95,10 +103,7 @@ public:
           solver_(s.attr("solver").cast<std::string>())
     {
         sphere::coupling_options o;
-        const double dem_steps = number(s.attr("dem_steps"), "fluid.dem_steps");
-        if (!(dem_steps >= 1 && dem_steps <= 4e9 && dem_steps == double(unsigned(dem_steps))))
-            sphere::detail::fail("fluid.dem_steps = ", dem_steps, ": a whole number from 1 to 4e9 is needed");
-        o.dem_steps = unsigned(dem_steps);
+        o.dem_steps = positive_count(s.attr("dem_steps"), "fluid.dem_steps");
         o.pressure_force = flag(s.attr("pressure_force"), "fluid.pressure_force");
         o.porosity = parse<sphere::porosity_method>(s.attr("porosity"), "fluid.porosity");
         const sphere::fluid_params<Real> fluid = fluid_params_from<Real>(s);
@@ -222,7 +227,7 @@ private:
         long long n[3];
         for (int a = 0; a < 3; ++a) {
             const double v = number(cells[py::int_(a)], "fluid: cells[" + std::to_string(a) + "]");
-            if (!(v == double((long long)v)))
+            if (!(std::abs(v) < 1e15) || v != std::floor(v)) // fluid_grid::make checks the range
                 sphere::detail::fail("fluid: cells[", a, "] = ", v, " is not a whole number");
             n[a] = (long long)v;
         }

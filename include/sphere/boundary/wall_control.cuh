@@ -20,6 +20,17 @@ enum class wall_mode : std::uint8_t {
     stress = 2,   ///< the wall has a mass and moves under its target stress and the particles' force
 };
 
+/// A wall mode's name as written in C++ ("fixed", "velocity", "stress").
+inline const char* name(wall_mode m)
+{
+    switch (m) {
+    case wall_mode::fixed: return "fixed";
+    case wall_mode::velocity: return "velocity";
+    case wall_mode::stress: return "stress";
+    }
+    return "?";
+}
+
 /// The motion of one wall face. Velocities and stresses are along the face's inward normal:
 /// a positive velocity moves the wall into the world, a positive stress compresses.
 template <class Real>

@@ -15,6 +15,9 @@ enum class boundary : std::uint8_t {
     periodic = 1, ///< a particle leaving at hi re-enters at lo; contacts see the nearest image
 };
 
+/// A boundary's name as written in C++ ("wall", "periodic").
+inline const char* name(boundary b) { return b == boundary::periodic ? "periodic" : "wall"; }
+
 template <class Real>
 struct world {
     vec3<Real> lo{0, 0, 0}; ///< lower corner (m)

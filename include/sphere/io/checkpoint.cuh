@@ -57,6 +57,8 @@ namespace sphere {
 /// the fluid section, version 5, which predates the bonds, and version 4, which predates the
 /// contact-law interface and holds the linear law's parameters without the law's name.
 inline constexpr std::uint32_t checkpoint_format_version = 8;
+/// The oldest format version this build reads (the linear law's only).
+inline constexpr std::uint32_t oldest_checkpoint_format_version = 4;
 
 /// The first 8 bytes of every checkpoint.
 inline constexpr char checkpoint_magic[9] = "SPHERECK";
@@ -476,10 +478,19 @@ struct checkpoint_header {
 
 namespace detail {
 
+/// "8, 7, 6 and 5": the versions this build reads for every contact law, newest first.
+inline std::string versions_for_every_law()
+{
+    std::string text;
+    for (std::uint32_t v = checkpoint_format_version; v > oldest_checkpoint_format_version; --v)
+        text += (text.empty() ? "" : v == oldest_checkpoint_format_version + 1 ? " and " : ", ") + std::to_string(v);
+    return text;
+}
+
 /// Checks the bytes of a checkpoint as far as its contact law's name: magic, a format version
-/// this build reads (4 to checkpoint_format_version), size, checksum and precision. Fills
-/// `header` and returns a decoder at the settings. Throws sphere::error naming `path` and what
-/// is wrong.
+/// this build reads (oldest_checkpoint_format_version to checkpoint_format_version), size,
+/// checksum and precision. Fills `header` and returns a decoder at the settings. Throws
+/// sphere::error naming `path` and what is wrong.
 inline checkpoint_decoder open_checkpoint(const std::string& bytes, const std::string& path, checkpoint_header& header)
 {
     constexpr std::size_t head_bytes = checkpoint_header_bytes, tail = checkpoint_checksum_bytes;
@@ -493,9 +504,9 @@ inline checkpoint_decoder open_checkpoint(const std::string& bytes, const std::s
              " of a header and checksum");
     checkpoint_decoder head(bytes, 8, head_bytes, path);
     const std::uint32_t version = head.u32("the format version");
-    if (version < 4 || version > checkpoint_format_version)
+    if (version < oldest_checkpoint_format_version || version > checkpoint_format_version)
         fail("checkpoint '", path, "': format version ", version, ", but this build reads versions ",
-             checkpoint_format_version, ", 7, 6 and 5, and 4 for the linear contact law");
+             versions_for_every_law(), ", and ", oldest_checkpoint_format_version, " for the linear contact law");
     const std::uint32_t precision = head.u32("the writer's precision");
     const std::uint64_t payload = head.u64("the payload size");
     if (payload > std::numeric_limits<std::uint64_t>::max() - head_bytes - tail)
@@ -556,9 +567,9 @@ checkpoint_data<Real, Law> decode_checkpoint(const std::string& bytes, const std
     checkpoint_header header;
     checkpoint_decoder d = detail::open_checkpoint(bytes, path, header);
     const std::uint32_t version = header.version;
-    if (version == 4 && !linear_params)
+    if (version == oldest_checkpoint_format_version && !linear_params)
         detail::fail("checkpoint '", path, "': format version 4, but this build reads versions ",
-                     checkpoint_format_version, ", 7, 6 and 5, and 4 only for the linear contact law, which version 4 "
+                     detail::versions_for_every_law(), ", and 4 only for the linear contact law, which version 4 "
                      "describes");
     if (version >= 5 && (header.law != Law::name() || header.history_layout != Law::history_layout))
         detail::fail("checkpoint '", path, "': written with the contact law ", header.law, " (history: ",
