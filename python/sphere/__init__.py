@@ -22,7 +22,7 @@ from .film import film
 from .fluid import Fluid, SolverHistory
 from .granular import deposited_sample, frictional_wall_contact, sample_contact, saved_sample
 from .program import ProgramRun, Status, find_program, outputs, read_output, run_program, status
-from .record import Recorder
+from .record import Recorder, write_csv
 from .samples import bimodal_radii, deposit, fit_world, lognormal_radii, random_packing, sample_top, uniform_radii
 from .settings import FACES, ContactParams, FluidBoundary, FluidSettings, Settings, WallControl
 from .shear import Shear, ShearSeries, shear
@@ -39,7 +39,7 @@ __all__ = [
     "random_packing", "read_checkpoint", "read_output", "Recorder", "Rose", "rose", "run_program", "sample_contact",
     "sample_top", "saved_sample", "Settings", "Shear", "shear", "ShearSeries", "ShearTracker", "Simulation",
     "Snapshot", "SolverHistory", "Status", "status", "stress_tensor", "uniform_radii", "void_ratio", "volume_between_walls",
-    "wall_stresses", "WallControl", "Walls", "Triaxial", "TriaxialSeries", "triaxial", "Uniaxial", "UniaxialSeries",
+    "wall_stresses", "WallControl", "Walls", "write_csv", "Triaxial", "TriaxialSeries", "triaxial", "Uniaxial", "UniaxialSeries",
     "uniaxial",
 ]
 

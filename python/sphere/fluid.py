@@ -9,6 +9,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .record import write_csv
 from .settings import FluidSettings
 from .simulation import Simulation, _steps_for, backend
 
@@ -202,6 +203,19 @@ class Fluid:
         z = self.centres()
         p_top = top.pressure + top.amplitude * np.sin(2 * np.pi * top.frequency * self.time + top.phase)
         return p_top + self._settings.density * self._settings.gravity[2] * (z - z[-1])
+
+    def write_vtk(self, path):
+        """Writes the fluid's cells to the VTK image `path` (.vti, atomically; docs/io.md): the
+        pressure, velocity, porosity and the model's other cell fields at the fluid's time, as
+        fluid_consolidation's frames."""
+        self._impl.write_vtk(os.fspath(path))
+
+    def write_csv(self, path):
+        """Writes solver_history to the CSV file `path` (atomically): time_s, iterations,
+        residual, converged (1 or 0), one row per coupled step."""
+        h = self.solver_history
+        write_csv(path, {"time_s": h.time, "iterations": h.iterations, "residual": h.residual,
+                         "converged": h.converged})
 
     def write_checkpoint(self, path):
         """Writes the simulation and the fluid's state to `path` (atomically): read_checkpoint

@@ -230,6 +230,12 @@ class Simulation:
         """Writes everything the simulation needs to continue to `path` (atomically)."""
         self._impl.write_checkpoint(os.fspath(path))
 
+    def write_vtk(self, path):
+        """Writes the particles to the VTK file `path` (.vtu, atomically; docs/io.md, *VTK
+        files*): positions, radii, velocities and every other particle field, the time as field
+        data, as the examples' frames. ParaView opens it."""
+        self._impl.write_vtk(os.fspath(path))
+
     def render(self, path, method="pres", max_val=None, lower_cutoff=0.0):
         """Writes a picture of the particles to the PNG file `path` (atomically) with the
         library's ray tracer (sphere::render_png, docs/render.md), as the original sphere's

@@ -6,6 +6,7 @@
 #include "settings.hpp"
 
 #include <sphere/fluid.cuh>
+#include <sphere/io/vti.cuh>
 
 #include <cmath>
 #include <limits>
@@ -202,6 +203,12 @@ public:
         }));
     }
 
+    /// The fluid's cells as a VTK image (io/vti.cuh) at the fluid's time.
+    void write_vtk(const std::string& path)
+    {
+        visit([&](auto& c) { sphere::write_vti(path, c, c.fluid().time()); });
+    }
+
     void write_checkpoint(const std::string& path, const Sim& sim)
     {
         visit([&](auto& c) { sphere::write_checkpoint(path, sim, c); });
@@ -308,6 +315,7 @@ void bind_fluid(py::module_& m)
         .def("velocity", &F::velocity)
         .def("darcy_flux", &F::darcy_flux)
         .def("conductivity", &F::conductivity)
+        .def("write_vtk", &F::write_vtk, py::arg("path"))
         .def("write_checkpoint", &F::write_checkpoint, py::arg("path"), py::arg("simulation"))
         .def("restore", &F::restore, py::arg("path"));
 }

@@ -51,6 +51,7 @@ void bind_simulation(py::module_& m)
         .def_static("restart", [](const std::string& path) { return sphere::restart<Sim>(path); }, py::arg("path"))
         .def("write_checkpoint", [](const Sim& s, const std::string& path) { sphere::write_checkpoint(path, s); },
              py::arg("path"))
+        .def("write_vtk", [](const Sim& s, const std::string& path) { sphere::write_vtu(path, s); }, py::arg("path"))
         .def("run", &Sim::run, py::arg("steps"))
         .def(
             "add_observer",
