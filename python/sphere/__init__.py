@@ -23,7 +23,8 @@ from .fluid import Fluid, SolverHistory
 from .granular import deposited_sample, frictional_wall_contact, sample_contact, saved_sample
 from .program import ProgramRun, Status, find_program, outputs, read_output, run_program, status
 from .record import Recorder, write_csv
-from .samples import bimodal_radii, deposit, fit_world, lognormal_radii, random_packing, sample_top, uniform_radii
+from .samples import (bimodal_radii, cubic_lattice, deposit, fit_world, jittered_lattice, lognormal_radii,
+                      random_packing, sample_top, uniform_radii)
 from .settings import FACES, ContactParams, FluidBoundary, FluidSettings, Settings, WallControl
 from .shear import Shear, ShearSeries, shear
 from .simulation import MOTION_KINDS, PRECISIONS, Simulation, read_checkpoint
@@ -32,8 +33,8 @@ from .uniaxial import Uniaxial, UniaxialSeries, uniaxial
 
 __all__ = [
     "__version__", "bimodal_radii", "consolidate", "Consolidation", "contact_counts", "contact_rose", "ContactParams",
-    "Contacts", "coordination", "deposit", "deposited_sample", "Energy", "Error", "FACES", "film", "find_program",
-    "fit_world", "Fluid", "FluidBoundary", "FluidSettings", "force_chains", "frictional_wall_contact", "ForceChains", "gamma_n_from_restitution",
+    "Contacts", "coordination", "cubic_lattice", "deposit", "deposited_sample", "Energy", "Error", "FACES", "film", "find_program",
+    "fit_world", "Fluid", "FluidBoundary", "FluidSettings", "force_chains", "frictional_wall_contact", "ForceChains", "gamma_n_from_restitution", "jittered_lattice",
     "lognormal_radii", "MOTION_KINDS",
     "orientations", "outputs", "porosity", "porosity_profile", "PorosityProfile", "PRECISIONS", "ProgramRun",
     "random_packing", "read_checkpoint", "read_output", "Recorder", "Rose", "rose", "run_program", "sample_contact",

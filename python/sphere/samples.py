@@ -1,5 +1,5 @@
 """Preparing samples (the library's setup/packing.cuh and particles/distributions.cuh): radii
-from distributions, random non-overlapping packings, the world fitted to the particles and
+from distributions, regular and jittered cubic lattices, random non-overlapping packings, the world fitted to the particles and
 deposition under gravity. Random choices follow a seed, with the same results as the C++
 functions; arrays come back in the precision asked for (float32 or float64), as the C++
 functions of that precision compute them.
@@ -31,6 +31,24 @@ def random_packing(radii, settings, seed, gap=0.0, max_tries=10000, precision="d
     boundary; on a periodic axis the centres fill [lo, hi)). Raises sphere.Error when a sphere
     cannot be placed in `max_tries` tries."""
     return backend(precision).random_packing(np.asarray(radii, dtype=np.float64), settings, seed, gap, max_tries)
+
+
+def cubic_lattice(n, spacing, origin=(0.0, 0.0, 0.0), precision="double"):
+    """Centres (N, 3) of an n = (nx, ny, nz) simple cubic lattice (the original's initGridPos):
+    particle i + nx (j + ny k) at origin + ((i + 1/2) s_x, (j + 1/2) s_y, (k + 1/2) s_z) for the
+    spacing s (m; one number or three), so spheres of radius s/2 touch each other and the
+    lattice's box."""
+    s = tuple(spacing) if np.ndim(spacing) else (spacing,) * 3
+    nx, ny, nz = n
+    return backend(precision).cubic_lattice(nx, ny, nz, s, tuple(origin))
+
+
+def jittered_lattice(n, spacing, jitter, seed, origin=(0.0, 0.0, 0.0), precision="double"):
+    """cubic_lattice with each centre moved by an offset uniform in [-jitter, jitter] (m) on
+    every axis, following `seed` (the original's initRandomGridPos); spacing >= 2 r_max + 2 jitter
+    keeps spheres of radius up to r_max apart."""
+    nx, ny, nz = n
+    return backend(precision).jittered_lattice(nx, ny, nz, spacing, jitter, seed, tuple(origin))
 
 
 def fit_world(settings, positions, radii, margin=2.0, headroom=0.0, precision="double"):

@@ -1,6 +1,6 @@
 #pragma once
 // The set-up helpers of one precision (setup/packing.cuh, particles/distributions.cuh): radii,
-// random packings and the world fitted to the particles, as NumPy arrays of Real.
+// lattices, random packings and the world fitted to the particles, as NumPy arrays of Real.
 #include "settings.hpp"
 
 namespace sphere_python {
@@ -37,6 +37,22 @@ void bind_setup(py::module_& m)
             return rows(sphere::random_packing(r, region, seed, Real(gap), max_tries));
         },
         py::arg("radii"), py::arg("settings"), py::arg("seed"), py::arg("gap"), py::arg("max_tries"));
+    m.def(
+        "cubic_lattice",
+        [](std::size_t nx, std::size_t ny, std::size_t nz, py::handle spacing, py::handle origin) {
+            return rows(sphere::cubic_lattice(nx, ny, nz, vector3<Real>(spacing, "cubic_lattice: spacing"),
+                                              vector3<Real>(origin, "cubic_lattice: origin")));
+        },
+        py::arg("nx"), py::arg("ny"), py::arg("nz"), py::arg("spacing"), py::arg("origin"));
+    m.def(
+        "jittered_lattice",
+        [](std::size_t nx, std::size_t ny, std::size_t nz, double spacing, double jitter, std::uint64_t seed,
+           py::handle origin) {
+            return rows(sphere::jittered_lattice(nx, ny, nz, Real(spacing), Real(jitter), seed,
+                                                 vector3<Real>(origin, "jittered_lattice: origin")));
+        },
+        py::arg("nx"), py::arg("ny"), py::arg("nz"), py::arg("spacing"), py::arg("jitter"), py::arg("seed"),
+        py::arg("origin"));
     m.def(
         "fit_world",
         [](py::handle settings, const doubles& positions, const doubles& radii, double margin, double headroom) {

@@ -1,4 +1,4 @@
-"""The set-up helpers: radii, random packings, the fitted world and deposition."""
+"""The set-up helpers: radii, lattices, random packings, the fitted world and deposition."""
 
 import numpy as np
 import pytest
@@ -35,6 +35,27 @@ def test_random_packing_does_not_overlap(precision):
         assert (x[:, a] - r >= 0).all() and (x[:, a] + r <= hi).all()
     with pytest.raises(sphere.Error, match="random_packing: could not place particle"):
         sphere.random_packing(np.full(100, 0.05), s, 1, max_tries=100, precision=precision)
+
+
+def test_lattices(precision):
+    x = sphere.cubic_lattice((3, 2, 4), 0.02, origin=(1.0, 0.0, -0.5), precision=precision)
+    assert x.shape == (24, 3) and x.dtype == (np.float32 if precision == "float" else np.float64)
+    # Particle i + nx (j + ny k) at origin + ((i, j, k) + 1/2) s.
+    i, j, k = np.arange(24) % 3, np.arange(24) // 3 % 2, np.arange(24) // 6
+    expected = np.array([1.0, 0.0, -0.5]) + (np.column_stack([i, j, k]) + 0.5) * 0.02
+    assert np.allclose(x, expected, rtol=0, atol=4 * eps(precision))
+    stretched = sphere.cubic_lattice((2, 2, 2), (0.01, 0.02, 0.03), precision=precision)
+    assert np.allclose(stretched.max(axis=0), [0.015, 0.03, 0.045], rtol=eps(precision))
+    jittered = sphere.jittered_lattice((3, 2, 4), 0.02, 0.002, 5, origin=(1.0, 0.0, -0.5), precision=precision)
+    offset = jittered.astype(np.float64) - x.astype(np.float64)
+    assert np.abs(offset).max() <= 0.002 * (1 + 1e-6) and np.abs(offset).max() > 0.0015
+    assert abs(offset.mean()) < 0.0005  # uniform in [-jitter, jitter]
+    np.testing.assert_array_equal(jittered, sphere.jittered_lattice((3, 2, 4), 0.02, 0.002, 5, origin=(1.0, 0.0, -0.5),
+                                                                    precision=precision))
+    with pytest.raises(sphere.Error, match="cubic_lattice: spacing"):
+        sphere.cubic_lattice((2, 2, 2), -0.01, precision=precision)
+    with pytest.raises(sphere.Error, match="jittered_lattice: jitter = -0.001[0-9]* m must be non-negative"):
+        sphere.jittered_lattice((2, 2, 2), 0.01, -0.001, 1, precision=precision)
 
 
 def test_fit_world(precision):
