@@ -128,8 +128,9 @@ int run(const options& o, const std::string& run_name, const std::string& bytes)
     const sphere::checkpoint_data<Real, Law> input = sphere::decode_checkpoint<Real, Law>(bytes, o.input);
     if (input.fluid)
         sphere::detail::fail("checkpoint '", o.input, "' holds a pore-fluid section (model ", input.fluid->model,
-                             "); the sphere program runs DEM checkpoints only: continue a coupled run from C++ "
-                             "(sphere::restart(path, coupling))");
+                             "); the sphere program runs DEM checkpoints only: continue a coupled run in-process "
+                             "with its coupling built as before (C++: sphere::restart(path, coupling); Python: "
+                             "sphere.Fluid(...).restore(path))");
     const double dt = double(input.config.dt);
     const program::run_files files{o.out, fs::path(o.input).stem().string()};
     const double t0 = double(input.state.steps) * dt;

@@ -197,3 +197,16 @@ def test_bad_grids_and_fields_of_the_other_model_are_named():
             getattr(fluid, field)()
     with pytest.raises(TypeError, match="a sphere.Simulation is needed"):
         sphere.Fluid("sim", (2, 2, 6))
+
+
+def test_the_program_refuses_a_coupled_checkpoint_and_says_how_to_continue(tmp_path):
+    from conftest import cpp_program
+
+    program = cpp_program("SPHERE_PROGRAM", "the sphere program")
+    sim = lattice_bed("double")
+    fluid = sphere.Fluid(sim, (2, 2, 6), sphere.FluidSettings(top=sphere.FluidBoundary("pressure")))
+    fluid.step()
+    fluid.write_checkpoint(tmp_path / "coupled.ck")
+    with pytest.raises(sphere.Error, match="holds a pore-fluid section \\(model navier_stokes\\); the sphere program "
+                                           "runs DEM checkpoints only: .*Python: sphere.Fluid\\(...\\).restore\\(path\\)"):
+        sphere.run_program(tmp_path / "coupled.ck", 1.0, out=tmp_path / "out", program=program)
