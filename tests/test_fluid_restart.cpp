@@ -11,7 +11,9 @@
 //   and a coupled restart from them is refused; a float file restores a double coupling;
 // - a snapshot of another model or grid, with an entry missing, unknown or of another length,
 //   or of another porosity method is refused with a message naming it, and nothing changes;
-// - a truncated or corrupt fluid section is refused.
+// - a truncated or corrupt fluid section is refused;
+// - the coupling's setup (fluid/setup.cuh) is stored and read back; restore() ignores it, and
+//   a snapshot without it has none to read.
 #include <catch2/catch.hpp>
 
 #include "checkpoint_bytes.hpp"
@@ -498,7 +500,7 @@ TEMPLATE_TEST_CASE("a truncated or corrupt fluid section is refused", "[fluid][r
     // ... and one that ends 4 bytes early, inside the last count's value.
     write_bytes(bad, as_version(b, 7, b.size() - 8 - 4, 4));
     CHECK_THROWS_WITH(sphere::read_checkpoint<Real>(bad),
-                      where + "inconsistent contents: the payload ends before the fluid count \"porosity.method\"");
+                      where + "inconsistent contents: the payload ends before the fluid count \"setup.drag\"");
     // A file cut short, and a flipped byte in the fluid section.
     write_bytes(bad, b.substr(0, first_values + 100));
     CHECK_THROWS_WITH(sphere::read_checkpoint<Real>(bad),
@@ -523,4 +525,65 @@ TEMPLATE_TEST_CASE("a truncated or corrupt fluid section is refused", "[fluid][r
                       where + "inconsistent contents: the fluid grid has 0 cells along axis 2, at least 1 is valid");
     // The intact file reads.
     CHECK_NOTHROW(sphere::read_checkpoint<Real>(coupled));
+}
+
+TEMPLATE_TEST_CASE("a coupled checkpoint stores the setup it was built from, and restores without it",
+                   "[fluid][restart][checkpoint][setup]", float, double)
+{
+    // fluid/setup.cuh: the "setup." entries of the coupling's snapshot give back the model, the
+    // solver and drag law by name, every fluid parameter and the coupling's options; restore()
+    // does not read them; a snapshot without them (an older file) has no setup to build from.
+    using Real = TestType;
+    temp_folder dir("sphere_fluid_setup");
+    sim_t<Real> sim(column_settings<Real>(), column_particles<Real>());
+    coupling_t<Real, sphere::cg_poisson<Real, sphere::host>> fluid =
+        column_coupling<Real, sphere::cg_poisson<Real, sphere::host>>();
+    fluid.step(sim);
+    const std::string path = dir / "coupled.ck";
+    sphere::write_checkpoint(path, sim, fluid);
+    const sphere::checkpoint_data<Real> d = sphere::read_checkpoint<Real>(path);
+    REQUIRE(d.fluid.has_value());
+    const sphere::coupling_setup<Real> got = sphere::coupling_setup<Real>::read(*d.fluid, "test");
+    CHECK(got.model == "navier_stokes");
+    CHECK(got.solver == "cg");
+    CHECK(got.drag == "gidaspow");
+    const sphere::fluid_params<Real> want = column_fluid<Real>();
+    CHECK(got.params.fluid.density == want.density);
+    CHECK(got.params.fluid.viscosity == want.viscosity);
+    CHECK(got.params.fluid.beta == want.beta);
+    CHECK(got.params.fluid.gravity.z == want.gravity.z);
+    CHECK(got.params.fluid.bottom.kind == sphere::fluid_boundary_kind::no_flow);
+    CHECK(got.params.fluid.top.kind == sphere::fluid_boundary_kind::pressure);
+    CHECK(got.params.fluid.top.amplitude == Real(20));
+    CHECK(got.params.fluid.top.frequency == Real(40));
+    CHECK(got.params.fluid.poisson.tolerance == want.poisson.tolerance);
+    CHECK(got.params.fluid.poisson.max_iterations == want.poisson.max_iterations);
+    CHECK(got.options.dem_steps == 5);
+    CHECK(got.options.pressure_force);
+    CHECK(got.options.porosity == sphere::porosity_method::cell_volume);
+
+    // The Darcy model's own parameters too.
+    const sphere::settings<Real> s = column_settings<Real>();
+    sphere::darcy_params<Real> prm;
+    prm.fluid = column_fluid<Real>();
+    prm.permeability_prefactor = Real(1e-9);
+    prm.max_porosity = Real(0.8);
+    sphere::fluid_coupling<Real, sphere::host, sphere::drag::ergun, sphere::mg_poisson<Real, sphere::host>, sphere::darcy_flow>
+        darcy(sphere::fluid_grid<Real>::make(s.box, 4, 4, 8), prm, column_options());
+    const sphere::coupling_setup<Real> d_got = sphere::coupling_setup<Real>::read(darcy.snapshot(), "test");
+    CHECK(d_got.model == "darcy");
+    CHECK(d_got.solver == "mg");
+    CHECK(d_got.drag == "ergun");
+    CHECK(d_got.params.permeability_prefactor == Real(1e-9));
+    CHECK(d_got.params.max_porosity == Real(0.8));
+    CHECK(d_got.params.compressibility == prm.compressibility);
+
+    // Without the setup entries (an older file): restore() still works, the setup is refused.
+    const sphere::fluid_snapshot<Real> older = d.fluid->other_than({"setup."});
+    coupling_t<Real, sphere::cg_poisson<Real, sphere::host>> target =
+        column_coupling<Real, sphere::cg_poisson<Real, sphere::host>>();
+    CHECK_NOTHROW(target.restore(older));
+    CHECK_THROWS_WITH(sphere::coupling_setup<Real>::read(older, "checkpoint 'x'"),
+                      "sphere: checkpoint 'x': the fluid section holds no setup (it was written before setups were "
+                      "stored): the coupling cannot be built from it");
 }

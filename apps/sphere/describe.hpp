@@ -1,6 +1,7 @@
 #pragma once
 // What `sphere --dry` prints (docs/program.md): the key settings of a checkpoint and the plan of
 // the run, so that a user sees the time step and the number of steps and outputs before a run.
+#include <sphere/fluid/setup.cuh>
 #include <sphere/io/checkpoint.cuh>
 
 #include "run_plan.hpp"
@@ -66,6 +67,37 @@ void describe(const std::string& input, const sphere::checkpoint_data<Real, Law>
     std::printf("outputs        %zu, every %zu steps (%.9g s): %s/%s ... %s\n", plan.outputs(), plan.every,
                 double(plan.every) * dt, files.folder.c_str(), files.numbered(0, ".ck").c_str(),
                 files.numbered(plan.outputs() - 1, ".ck").c_str());
+}
+
+/// Prints a coupled checkpoint's fluid (its setup, fluid/setup.cuh, and the grid of its fluid
+/// section `state`) for --dry; `dt` is the DEM time step (s).
+template <class Real>
+void describe_fluid(const sphere::coupling_setup<Real>& c, const sphere::fluid_snapshot<Real>& state, double dt)
+{
+    const auto& f = c.params.fluid;
+    std::printf("fluid          %s (%s pressure solver, %s drag), %u x %u x %u cells over [%g, %g] x [%g, %g] x [%g, %g] m\n",
+                c.model.c_str(), c.solver.c_str(), c.drag.c_str(), state.n[0], state.n[1], state.n[2], state.lo[0],
+                state.hi[0], state.lo[1], state.hi[1], state.lo[2], state.hi[2]);
+    std::printf("fluid step     %u DEM steps: %.9g s\n", c.options.dem_steps, c.options.dem_steps * dt);
+    std::printf("fluid          density %g kg/m^3, viscosity %g Pa s, beta %g, gravity (%g, %g, %g) m/s^2\n",
+                double(f.density), double(f.viscosity), double(f.beta), double(f.gravity.x), double(f.gravity.y),
+                double(f.gravity.z));
+    const char* kinds[3] = {"no flow", "pressure", "inflow"};
+    const sphere::fluid_boundary<Real>* ends[2] = {&f.bottom, &f.top};
+    const char* names[2] = {"bottom", "top"};
+    for (int e = 0; e < 2; ++e) {
+        const auto& b = *ends[e];
+        std::printf("fluid %-8s %s", names[e], kinds[int(b.kind)]);
+        if (b.kind == sphere::fluid_boundary_kind::pressure)
+            std::printf(" %g Pa (amplitude %g Pa, %g Hz)", double(b.pressure), double(b.amplitude),
+                        double(b.frequency));
+        if (b.kind == sphere::fluid_boundary_kind::inflow) std::printf(" %g m/s", double(b.velocity));
+        std::printf("\n");
+    }
+    if (c.model == "darcy")
+        std::printf("darcy          compressibility %g 1/Pa, permeability prefactor %g m^2, max porosity %g\n",
+                    double(c.params.compressibility), double(c.params.permeability_prefactor),
+                    double(c.params.max_porosity));
 }
 
 } // namespace program

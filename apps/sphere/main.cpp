@@ -2,7 +2,9 @@
 // numbered checkpoints and VTK frames at an interval of simulated time, a status file and a
 // progress line; resumes from its last output after a crash (docs/program.md).
 #include <sphere/dem.cuh>
+#include <sphere/fluid.cuh>
 #include <sphere/io.cuh>
+#include <sphere/io/vti.cuh>
 
 #include <CLI/CLI.hpp>
 #if defined(SPHERE_PROGRAM_PNG)
@@ -22,6 +24,7 @@
 #include <limits>
 #include <optional>
 #include <string>
+#include <type_traits>
 
 #ifndef SPHERE_PROGRAM_VERSION
 #define SPHERE_PROGRAM_VERSION "unknown"
@@ -91,7 +94,9 @@ void remove_earlier_run(const program::run_files& files)
     for (const auto& entry : fs::directory_iterator(files.folder, ec)) {
         const std::string name = entry.path().filename().string();
         const bool numbered = name.rfind(files.name + ".output", 0) == 0;
-        if (numbered || name == files.name + ".pvd" || name == files.name + ".status.dat") fs::remove(entry.path());
+        if (numbered || name == files.name + ".pvd" || name == files.name + ".fluid.pvd" ||
+            name == files.name + ".status.dat")
+            fs::remove(entry.path());
     }
 }
 
@@ -118,19 +123,18 @@ void write_picture(const options& o, const sphere::particle_snapshot<Real>& snap
 #endif
 }
 
-/// Runs the checkpoint (the input file's bytes) with the simulation type Sim (its precision,
-/// law, backend and integrator).
-template <class Sim>
-int run(const options& o, const std::string& run_name, const std::string& bytes)
+/// What a run without pore fluid couples to its simulation: nothing.
+struct no_fluid {};
+
+/// Runs the checkpoint `input` (`bytes` the input file's) with the simulation type Sim (its
+/// precision, law, backend and integrator), coupled to the pore fluid `fluid` (a
+/// fluid_coupling built from the checkpoint's setup, its state restored from it here), or to
+/// none (Fluid = no_fluid, `fluid` null).
+template <class Sim, class Fluid>
+int run_with(const options& o, const std::string& run_name, const std::string& bytes,
+             const sphere::checkpoint_data<typename Sim::real_type, typename Sim::law_type>& input, Fluid* fluid)
 {
-    using Real = typename Sim::real_type;
-    using Law = typename Sim::law_type;
-    const sphere::checkpoint_data<Real, Law> input = sphere::decode_checkpoint<Real, Law>(bytes, o.input);
-    if (input.fluid)
-        sphere::detail::fail("checkpoint '", o.input, "' holds a pore-fluid section (model ", input.fluid->model,
-                             "); the sphere program runs DEM checkpoints only: continue a coupled run in-process "
-                             "with its coupling built as before (C++: sphere::restart(path, coupling); Python: "
-                             "sphere.Fluid(...).restore(path))");
+    constexpr bool coupled = !std::is_same_v<Fluid, no_fluid>;
     const double dt = double(input.config.dt);
     const program::run_files files{o.out, fs::path(o.input).stem().string()};
     const double t0 = double(input.state.steps) * dt;
@@ -145,10 +149,13 @@ int run(const options& o, const std::string& run_name, const std::string& bytes)
     }
     if (!o.dry && !std::isfinite(o.total)) sphere::detail::fail("--total: the simulated time to run to (s) is required");
     const double total = std::isfinite(o.total) ? o.total : t0; // --dry without it: the settings and an empty run
-    const double interval = !std::isnan(o.interval) ? o.interval : total > t0 ? (total - t0) / 10 : dt;
-    const program::run_plan plan = program::run_plan::make(input.state.steps, dt, total, interval);
+    std::size_t stride = 1; // steps between the times the run may stop: a coupled run's fluid step
+    if constexpr (coupled) stride = fluid->options().dem_steps;
+    const double interval = !std::isnan(o.interval) ? o.interval : total > t0 ? (total - t0) / 10 : dt * double(stride);
+    const program::run_plan plan = program::run_plan::make(input.state.steps, dt, total, interval, stride);
     if (o.dry) {
         program::describe(o.input, input, run_name, plan, files);
+        if constexpr (coupled) program::describe_fluid(fluid->setup(), *input.fluid, dt);
         if (!std::isfinite(o.total)) std::printf("(no --total given: a run needs one)\n");
         return 0;
     }
@@ -167,7 +174,7 @@ int run(const options& o, const std::string& run_name, const std::string& bytes)
 
     std::optional<Sim> sim;
     std::size_t output = 0;
-    sphere::pvd_collection frames(files.collection());
+    sphere::pvd_collection frames(files.collection()), fluid_frames(files.fluid_collection());
     if (fs::exists(files.status())) {
         const program::run_status earlier = program::run_status::read(files.status());
         const std::string difference = status.difference(earlier);
@@ -178,7 +185,8 @@ int run(const options& o, const std::string& run_name, const std::string& bytes)
         if (output >= plan.outputs())
             sphere::detail::fail("status file '", files.status(), "': last output ", output, ", but the run has ",
                                  plan.outputs());
-        sim.emplace(sphere::restart<Sim>(files.checkpoint(output)));
+        if constexpr (coupled) sim.emplace(sphere::restart<Sim>(files.checkpoint(output), *fluid));
+        else sim.emplace(sphere::restart<Sim>(files.checkpoint(output)));
         if (sim->steps() != plan.step_of(output))
             sphere::detail::fail("'", files.checkpoint(output), "' is at step ", sim->steps(), ", output ", output,
                                  " of this run is at step ", plan.step_of(output));
@@ -186,16 +194,26 @@ int run(const options& o, const std::string& run_name, const std::string& bytes)
             frames = sphere::pvd_collection::load(files.collection());
             frames.drop_from(sim->time() + dt / 2);
         }
+        if (coupled && o.vtk && fs::exists(files.fluid_collection())) {
+            fluid_frames = sphere::pvd_collection::load(files.fluid_collection());
+            fluid_frames.drop_from(sim->time() + dt / 2);
+        }
         if (!o.quiet) std::printf("resuming from output %zu (t = %.9g s)\n", output, sim->time());
     } else {
         sim.emplace(sphere::detail::restart_from<Sim>(input));
+        if constexpr (coupled) fluid->restore(*input.fluid);
     }
 
     const auto write_output = [&](std::size_t k) {
-        sphere::write_checkpoint(files.checkpoint(k), *sim);
+        if constexpr (coupled) sphere::write_checkpoint(files.checkpoint(k), *sim, *fluid);
+        else sphere::write_checkpoint(files.checkpoint(k), *sim);
         if (o.vtk) {
             sphere::write_vtu(files.folder + "/" + files.frame(k), *sim);
             frames.add(sim->time(), files.frame(k));
+            if constexpr (coupled) {
+                sphere::write_vti(files.folder + "/" + files.fluid_frame(k), *fluid, sim->time());
+                fluid_frames.add(sim->time(), files.fluid_frame(k));
+            }
         }
         if (!o.render.empty()) write_picture(o, sim->snapshot(), files.folder + "/" + files.numbered(k, ".png"));
         status.time = sim->time();
@@ -211,7 +229,8 @@ int run(const options& o, const std::string& run_name, const std::string& bytes)
     bar.show(sim->steps(), sim->time(), output, true);
     for (std::size_t k = output + 1; k < plan.outputs(); ++k) {
         while (sim->steps() < plan.step_of(k)) {
-            sim->run(std::min<std::size_t>(plan.step_of(k) - sim->steps(), 100));
+            if constexpr (coupled) fluid->step(*sim); // dem_steps steps, which divide the outputs' steps
+            else sim->run(std::min<std::size_t>(plan.step_of(k) - sim->steps(), 100));
             bar.show(sim->steps(), sim->time(), k - 1, false);
         }
         write_output(k);
@@ -222,9 +241,80 @@ int run(const options& o, const std::string& run_name, const std::string& bytes)
     if (!o.quiet)
         std::printf("t = %.9g s after %zu steps; output in %s/: %s.output00000 to %05zu (.ck%s%s), %s.status.dat%s\n",
                     sim->time(), sim->steps(), o.out.c_str(), files.name.c_str(), plan.outputs() - 1,
-                    o.vtk ? ", .vtu, .pvd" : "", o.render.empty() ? "" : ", .png", files.name.c_str(),
+                    !o.vtk ? "" : coupled ? ", .vtu, .vti, .pvd, .fluid.pvd" : ", .vtu, .pvd",
+                    o.render.empty() ? "" : ", .png", files.name.c_str(),
                     filmed ? (", " + files.name + ".mp4").c_str() : "");
     return 0;
+}
+
+/// Runs a coupled checkpoint: the coupling its setup describes (fluid/setup.cuh), on the grid
+/// of its fluid section. The program builds the Gidaspow drag law with the mg or cg solver, in
+/// float or double on the host backend.
+template <class Sim>
+int run_coupled(const options& o, const std::string& run_name, const std::string& bytes,
+                const sphere::checkpoint_data<typename Sim::real_type, typename Sim::law_type>& input)
+{
+    using Real = typename Sim::real_type;
+    const std::string where = "checkpoint '" + o.input + "'";
+    const sphere::fluid_snapshot<Real>& state = *input.fluid;
+#if defined(SPHERE_PROGRAM_CUDA)
+    (void)run_name, (void)bytes, (void)state;
+    sphere::detail::fail(where, " holds a pore-fluid section (model ", state.model,
+                         "): sphere-cuda runs DEM checkpoints; the sphere program runs coupled ones on the host");
+#else
+    constexpr bool runs = std::is_same_v<typename Sim::precision_type, Real> &&
+                          std::is_same_v<typename Sim::policy_type, sphere::host>;
+    if constexpr (!runs) {
+        sphere::detail::fail(where, " holds a pore-fluid section (model ", state.model, "): precision ",
+                             o.precision, " is not coupled to the pore fluid; use float or double");
+    } else {
+        const sphere::coupling_setup<Real> setup = sphere::coupling_setup<Real>::read(state, where.c_str());
+        if (setup.drag != sphere::drag::gidaspow::name())
+            sphere::detail::fail(where, ": the drag law ", setup.drag, "; the sphere program builds ",
+                                 sphere::drag::gidaspow::name(), " (others: restart from C++)");
+        sphere::world<Real> box;
+        for (int a = 0; a < 3; ++a) {
+            box.lo[a] = Real(state.lo[a]);
+            box.hi[a] = Real(state.hi[a]);
+        }
+        const sphere::fluid_grid<Real> grid = sphere::fluid_grid<Real>::make(box, state.n[0], state.n[1], state.n[2]);
+        const std::string name = run_name + ", " + setup.model + " (" + setup.solver + ")";
+        const auto with = [&](auto* type, const auto& params) {
+            using Coupling = std::remove_pointer_t<decltype(type)>;
+            Coupling coupling(grid, params, setup.options);
+            return run_with<Sim>(o, name, bytes, input, &coupling);
+        };
+        using gidaspow = sphere::drag::gidaspow;
+        using mg = sphere::mg_poisson<Real, sphere::host>;
+        using cg = sphere::cg_poisson<Real, sphere::host>;
+        if (setup.model == "navier_stokes" && setup.solver == "mg")
+            return with(static_cast<sphere::fluid_coupling<Real, sphere::host, gidaspow, mg, sphere::navier_stokes>*>(nullptr),
+                        setup.params.fluid);
+        if (setup.model == "navier_stokes" && setup.solver == "cg")
+            return with(static_cast<sphere::fluid_coupling<Real, sphere::host, gidaspow, cg, sphere::navier_stokes>*>(nullptr),
+                        setup.params.fluid);
+        if (setup.model == "darcy" && setup.solver == "mg")
+            return with(static_cast<sphere::fluid_coupling<Real, sphere::host, gidaspow, mg, sphere::darcy_flow>*>(nullptr),
+                        setup.params);
+        if (setup.model == "darcy" && setup.solver == "cg")
+            return with(static_cast<sphere::fluid_coupling<Real, sphere::host, gidaspow, cg, sphere::darcy_flow>*>(nullptr),
+                        setup.params);
+        sphere::detail::fail(where, ": the model ", setup.model, " with the pressure solver ", setup.solver,
+                             "; the sphere program builds navier_stokes and darcy with mg or cg");
+    }
+#endif
+}
+
+/// Runs the checkpoint (`bytes` the input file's) with the simulation type Sim: coupled to the
+/// pore fluid its fluid section describes, or on its own.
+template <class Sim>
+int run(const options& o, const std::string& run_name, const std::string& bytes)
+{
+    using Real = typename Sim::real_type;
+    using Law = typename Sim::law_type;
+    const sphere::checkpoint_data<Real, Law> input = sphere::decode_checkpoint<Real, Law>(bytes, o.input);
+    if (input.fluid) return run_coupled<Sim>(o, run_name, bytes, input);
+    return run_with<Sim>(o, run_name, bytes, input, static_cast<no_fluid*>(nullptr));
 }
 
 /// The simulation type for the options and the checkpoint's precision and law; runs it.

@@ -36,8 +36,10 @@ struct run_plan {
 
     /// The steps from the input's time t0 = first dt to `total` (s), rounded up (to the nearest
     /// step where total / dt is within 1e-9 of it), and an output every round(interval / dt)
-    /// steps (at least 1). Throws sphere::error for a total before t0 or a non-positive interval.
-    static run_plan make(std::size_t first, double dt, double total, double interval)
+    /// steps (at least 1), both in whole strides of `stride` steps from `first` (a coupled
+    /// run's fluid step: dem_steps DEM steps). Throws sphere::error for a total before t0 or a
+    /// non-positive interval.
+    static run_plan make(std::size_t first, double dt, double total, double interval, std::size_t stride = 1)
     {
         const double t0 = double(first) * dt;
         if (!(total >= t0) || !std::isfinite(total))
@@ -51,8 +53,10 @@ struct run_plan {
             sphere::detail::fail("--total ", short_number(total), " s is ", to_total, " steps of ", dt, " s: too many");
         run_plan p;
         p.first = first;
-        p.last = std::max(first, static_cast<std::size_t>(to_total));
-        p.every = std::max<std::size_t>(1, static_cast<std::size_t>(std::llround(interval / dt)));
+        const std::size_t steps_to_total = std::max(first, static_cast<std::size_t>(to_total)) - first;
+        p.last = first + (steps_to_total + stride - 1) / stride * stride;
+        const double strides = std::round(interval / (dt * double(stride)));
+        p.every = stride * std::max<std::size_t>(1, static_cast<std::size_t>(strides));
         return p;
     }
 
@@ -76,6 +80,9 @@ struct run_files {
     std::string checkpoint(std::size_t k) const { return folder + "/" + numbered(k, ".ck"); }
     std::string frame(std::size_t k) const { return numbered(k, ".vtu"); } // relative to the folder, as the .pvd lists it
     std::string collection() const { return folder + "/" + name + ".pvd"; }
+    /// A coupled run's fluid frames and their collection.
+    std::string fluid_frame(std::size_t k) const { return numbered(k, ".vti"); }
+    std::string fluid_collection() const { return folder + "/" + name + ".fluid.pvd"; }
     std::string status() const { return folder + "/" + name + ".status.dat"; }
 };
 

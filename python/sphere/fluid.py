@@ -10,7 +10,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from .record import write_csv
-from .settings import FluidSettings
+from ._sphere import Error
+from .settings import FluidBoundary, FluidSettings
 from .simulation import Simulation, _steps_for, backend
 
 
@@ -48,6 +49,33 @@ class Fluid:
         self._sim = simulation
         self._settings = settings
         self._history = []
+
+    @classmethod
+    def from_checkpoint(cls, simulation, path):
+        """The Fluid a checkpoint of a coupled run describes (its cells and FluidSettings, which
+        Fluid.write_checkpoint and the sphere program store beside the fluid's state), built on
+        `simulation` (read from the same file with sphere.read_checkpoint) and restored from
+        it: the sphere program's outputs of a coupled run read back. Raises sphere.Error for a
+        file without a fluid section or setup, or a drag law other than Gidaspow's."""
+        path = os.fspath(path)
+        d = backend(simulation.precision).fluid_setup(path)
+        if d["drag"] != "gidaspow":
+            raise Error(f"sphere: checkpoint '{path}': the drag law {d['drag']}; sphere.Fluid builds gidaspow")
+
+        def end(name):
+            return FluidBoundary(d[name + "_kind"], *(d[f"{name}_{field}"] for field in
+                                                      ("pressure", "amplitude", "frequency", "phase", "velocity")))
+
+        settings = FluidSettings(
+            model=d["model"], solver=d["solver"], density=d["density"], viscosity=d["viscosity"], beta=d["beta"],
+            gravity=(d["gravity_x"], d["gravity_y"], d["gravity_z"]), bottom=end("bottom"), top=end("top"),
+            tolerance=d["tolerance"], max_iterations=d["max_iterations"], criterion=d["criterion"],
+            compressibility=d["compressibility"], permeability_prefactor=d["permeability_prefactor"],
+            max_porosity=d["max_porosity"], dem_steps=d["dem_steps"], pressure_force=d["pressure_force"],
+            porosity=d["porosity_method"])
+        fluid = cls(simulation, d["cells"], settings)
+        fluid.restore(path)
+        return fluid
 
     def __repr__(self):
         nx, ny, nz = self.cells

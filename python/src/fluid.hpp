@@ -286,10 +286,38 @@ private:
     any_coupling c_;
 };
 
-/// Binds fluid_binding<Real> as `Fluid` into m.
+/// The setup of the coupled run a checkpoint holds (fluid/setup.cuh) as a dict: model, solver,
+/// drag, cells, and every field of coupling_setup::fields by its name (enumerations by name).
+template <class Real>
+py::dict fluid_setup_of(const std::string& path)
+{
+    const sphere::checkpoint_data<Real> c = sphere::read_checkpoint<Real>(path);
+    if (!c.fluid)
+        sphere::detail::fail("checkpoint '", path, "': no fluid section (format version ", c.version,
+                             "); Fluid.write_checkpoint writes one");
+    const std::string where = "checkpoint '" + path + "'";
+    const sphere::coupling_setup<Real> setup = sphere::coupling_setup<Real>::read(*c.fluid, where.c_str());
+    py::dict d;
+    d["model"] = setup.model;
+    d["solver"] = setup.solver;
+    d["drag"] = setup.drag;
+    d["cells"] = py::make_tuple(c.fluid->n[0], c.fluid->n[1], c.fluid->n[2]);
+    sphere::coupling_setup<Real>::fields(
+        setup, [&](const char* name, const auto& field) { d[name] = double(field); },
+        [&](const char* name, const auto& field, std::uint64_t) {
+            using T = std::decay_t<decltype(field)>;
+            if constexpr (std::is_enum_v<T>) d[name] = name_of(field);
+            else if constexpr (std::is_same_v<T, bool>) d[name] = field;
+            else d[name] = std::uint64_t(field);
+        });
+    return d;
+}
+
+/// Binds fluid_binding<Real> as `Fluid` into m, and fluid_setup.
 template <class Real>
 void bind_fluid(py::module_& m)
 {
+    m.def("fluid_setup", &fluid_setup_of<Real>, py::arg("path"));
     using F = fluid_binding<Real>;
     using Sim = sphere::simulation<Real>;
     py::class_<F>(m, "Fluid", "the pore fluid coupled to a simulation (sphere::fluid_coupling, host backend)")

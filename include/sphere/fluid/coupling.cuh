@@ -27,6 +27,7 @@
 /// m_i / (beta_per_solid V_i) (checked; the step throws naming the particle).
 #include <cmath>
 #include <cstddef>
+#include <string>
 #include <type_traits>
 
 #include "../boundary/world.cuh"
@@ -41,20 +42,22 @@
 #include "drag.cuh"
 #include "navier_stokes.cuh"
 #include "porosity.cuh"
+#include "setup.cuh"
 #include "snapshot.cuh"
 
 namespace sphere {
 
-/// How the fluid and the particles are coupled.
-struct coupling_options {
-    unsigned dem_steps = 10;     ///< DEM steps per fluid step
-    bool pressure_force = true;  ///< apply -V_p grad p to the particles (and its reaction to the fluid)
-    /// How the cells' solid volume is measured: cell_volume conserves the grid's solid volume
-    /// (needed for a closed box); cell_sphere is the seeds' estimator.
-    porosity_method porosity = porosity_method::cell_volume;
-};
-
 namespace detail {
+
+/// T::name() where T has one (the library's drag laws and pressure solvers), else "(other)".
+template <class T, class = void>
+struct name_or_other {
+    static std::string get() { return "(other)"; }
+};
+template <class T>
+struct name_or_other<T, std::void_t<decltype(T::name())>> {
+    static std::string get() { return T::name(); }
+};
 
 /// values[i] (a reduction's transform over an array).
 template <class T>
@@ -173,17 +176,32 @@ public:
         return r.work_total;
     }
 
+    /// What this coupling is built from (fluid/setup.cuh).
+    coupling_setup<Real> setup() const
+    {
+        coupling_setup<Real> c;
+        c.model = model_type::model_name();
+        c.solver = detail::name_or_other<Poisson>::get();
+        c.drag = detail::name_or_other<Drag>::get();
+        if constexpr (std::is_same_v<std::decay_t<decltype(fluid_.params())>, darcy_params<Real>>) c.params = fluid_.params();
+        else c.params.fluid = fluid_.params();
+        c.options = options_;
+        return c;
+    }
+
     /// A host copy of the coupling's evolving state (fluid/snapshot.cuh; docs/fluid.md,
     /// *Restarting a coupled run*), for write_checkpoint(path, sim, coupling): the fluid
     /// model's snapshot (its entries under their own names, its model name the snapshot's),
-    /// the porosity estimator's under "porosity.", and work_on_particles() as the number
-    /// "coupling.work_total". Nothing else carries over from one coupled step to the next:
-    /// the particle forces, response times and start positions are written by each step before
-    /// they are read.
+    /// the porosity estimator's under "porosity.", the setup() under "setup." (what the
+    /// coupling is built from: read by the sphere program, not by restore()), and
+    /// work_on_particles() as the number "coupling.work_total". Nothing else carries over from
+    /// one coupled step to the next: the particle forces, response times and start positions
+    /// are written by each step before they are read.
     fluid_snapshot<Real> snapshot()
     {
         fluid_snapshot<Real> s = fluid_.snapshot();
         s.merge("porosity.", porosity_.snapshot());
+        s.merge("setup.", setup().snapshot(porosity_.grid()));
         s.add_number("coupling.work_total", work_on_particles());
         return s;
     }
@@ -206,7 +224,7 @@ public:
         if (!std::isfinite(work)) detail::fail(who, ": the snapshot's work_total = ", work, " J is not finite");
         const fluid_snapshot<Real> por = s.part("porosity.", porosity_.model_name());
         porosity_.check_snapshot(por);
-        fluid_.restore(s.other_than({"porosity.", "coupling."})); // checks everything before it changes anything
+        fluid_.restore(s.other_than({"porosity.", "coupling.", "setup."})); // checks everything before it changes anything
         porosity_.restore(por);
         for_each_index(Policy{}, 1, set_work_total{fluid_.report(), work});
     }

@@ -75,6 +75,7 @@ SPHERE_HD Real drag_coefficient(Real re)
 
 /// Ergun (1952) momentum-exchange coefficient for packed beds, at every porosity.
 struct ergun {
+    static const char* name() { return "ergun"; }
     /// No parameters.
     static void validate() {}
 
@@ -97,6 +98,7 @@ struct ergun {
 /// Wen & Yu (1966) momentum-exchange coefficient for dilute suspensions, in Gidaspow's
 /// dimensionally correct form, at every porosity.
 struct wen_yu {
+    static const char* name() { return "wen_yu"; }
     /// No parameters.
     static void validate() {}
 
@@ -123,6 +125,7 @@ struct wen_yu {
 /// factor 1.153313 from just below to just above (VALIDATION pitfall 5); at finite Re the
 /// factor differs (1.1106 at Re = 16, 3.23 at Re = 640, see docs/fluid.md).
 struct gidaspow {
+    static const char* name() { return "gidaspow"; }
     /// No parameters.
     static void validate() {}
 
@@ -150,6 +153,7 @@ struct gidaspow {
 /// over phi = 0.8 -+ 0.01173 (tan(0.4 pi) / 262.5); its tails are slow, 1 - w (or w)
 /// ~ 1 / (262.5 pi |phi - 0.8|): 0.30% at phi = 0.4, 1.2% at 0.7 and 0.9.
 struct gidaspow_blended {
+    static const char* name() { return "gidaspow_blended"; }
     /// The slope of the arctan in w (dimensionless).
     template <class Real> static constexpr Real slope = Real(262.5);
 

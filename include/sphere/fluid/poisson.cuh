@@ -1109,6 +1109,8 @@ class jacobi_poisson : public detail::poisson_solver_base<jacobi_poisson<Real, P
     friend base;
 
 public:
+    static const char* name() { return "jacobi"; }
+
     explicit jacobi_poisson(const fluid_grid<Real>& g) : base(g), scratch_(g.field_size(), Real(0)) {}
 
 private:

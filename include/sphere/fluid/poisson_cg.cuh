@@ -303,6 +303,8 @@ class cg_poisson : public detail::poisson_solver_base<cg_poisson<Real, Policy>, 
     friend base;
 
 public:
+    static const char* name() { return "cg"; }
+
     explicit cg_poisson(const fluid_grid<Real>& g)
         : base(g), r_(g.field_size(), Real(0)), p_(g.field_size(), Real(0)), q_(g.field_size(), Real(0))
     {

@@ -550,6 +550,8 @@ class mg_poisson : public detail::poisson_solver_base<mg_poisson<Real, Policy>, 
     friend base;
 
 public:
+    static const char* name() { return "mg"; }
+
     explicit mg_poisson(const fluid_grid<Real>& g)
         : base(g), r_(g.field_size(), Real(0)), p_(g.field_size(), Real(0)), q_(g.field_size(), Real(0)),
           z_(g.field_size(), Real(0))
