@@ -4,7 +4,7 @@
 /// model, the pressure solver and the drag law by name, the fluid's parameters and the
 /// coupling's options. fluid_coupling::snapshot() stores them as the "setup." entries of its
 /// snapshot, so that a checkpoint of a coupled run describes the coupling it continues with
-/// (the sphere program builds it from them: apps/sphere/coupled.hpp); restore() does not read
+/// (the sphere program builds it from them: apps/sphere/main.cpp); restore() does not read
 /// them (the coupling is the caller's). Host-only code.
 #include <cstddef>
 #include <cstdint>
