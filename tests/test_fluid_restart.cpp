@@ -13,7 +13,8 @@
 //   or of another porosity method is refused with a message naming it, and nothing changes;
 // - a truncated or corrupt fluid section is refused;
 // - the coupling's setup (fluid/setup.cuh) is stored and read back; restore() ignores it, and
-//   a snapshot without it has none to read.
+//   a snapshot without it has none to read; make_coupling (fluid/setup_coupling.cuh) builds the
+//   coupling a setup names, with the typed coupling's bits, and names what it cannot build.
 #include <catch2/catch.hpp>
 
 #include "checkpoint_bytes.hpp"
@@ -28,9 +29,11 @@
 #include <cstdint>
 #include <cstring>
 #include <fstream>
+#include <memory>
 #include <string>
 #include <type_traits>
 #include <utility>
+#include <variant>
 #include <vector>
 
 namespace {
@@ -586,4 +589,69 @@ TEMPLATE_TEST_CASE("a coupled checkpoint stores the setup it was built from, and
     CHECK_THROWS_WITH(sphere::coupling_setup<Real>::read(older, "checkpoint 'x'"),
                       "sphere: checkpoint 'x': the fluid section holds no setup (it was written before setups were "
                       "stored): the coupling cannot be built from it");
+}
+
+TEMPLATE_TEST_CASE("make_coupling builds the coupling a setup names: the typed coupling's bits, and names what it "
+                   "cannot build",
+                   "[fluid][setup]", float, double)
+{
+    // fluid/setup_coupling.cuh: from the setup() of each of the four couplings it builds
+    // (Navier-Stokes and Darcy, mg and cg, Gidaspow), make_coupling gives that coupling's type,
+    // the same setup, and after two coupled steps of the column the same bits as the coupling
+    // built by its type.
+    using Real = TestType;
+    using gidaspow = sphere::drag::gidaspow;
+    using mg = sphere::mg_poisson<Real, sphere::host>;
+    using cg = sphere::cg_poisson<Real, sphere::host>;
+    const sphere::settings<Real> s = column_settings<Real>();
+    const sphere::fluid_grid<Real> grid = sphere::fluid_grid<Real>::make(s.box, 4, 4, 8);
+    sphere::darcy_params<Real> darcy;
+    darcy.fluid = column_fluid<Real>();
+    darcy.permeability_prefactor = Real(0.9e-3 * 0.9e-3 / 180);
+    const auto compare = [&](auto* type, const auto& params, std::size_t index) {
+        using Coupling = std::remove_pointer_t<decltype(type)>;
+        Coupling typed(grid, params, column_options());
+        const sphere::coupling_setup<Real> setup = typed.setup();
+        INFO(setup.model << " with " << setup.solver);
+        sphere::setup_coupling<Real, sphere::host> built = sphere::make_coupling<Real, sphere::host>(setup, grid, "test");
+        REQUIRE(built.index() == index);
+        Coupling& same = *std::get<std::unique_ptr<Coupling>>(built);
+        CHECK(same.setup().snapshot(grid).numbers.size() == setup.snapshot(grid).numbers.size());
+        const sphere::fluid_snapshot<Real> want = setup.snapshot(grid), got = same.setup().snapshot(grid);
+        for (std::size_t k = 0; k < want.numbers.size() && k < got.numbers.size(); ++k)
+            CHECK((want.numbers[k].name == got.numbers[k].name && same_bits(want.numbers[k].value, got.numbers[k].value)));
+        for (std::size_t k = 0; k < want.counts.size() && k < got.counts.size(); ++k)
+            CHECK((want.counts[k].name == got.counts[k].name && want.counts[k].value == got.counts[k].value));
+        sim_t<Real> a(column_settings<Real>(), column_particles<Real>()), b(column_settings<Real>(), column_particles<Real>());
+        for (int k = 0; k < 2; ++k) {
+            typed.step(a);
+            same.step(b);
+        }
+        CHECK(identical(observe(a, typed), observe(b, same)));
+    };
+    compare(static_cast<sphere::fluid_coupling<Real, sphere::host, gidaspow, mg, sphere::navier_stokes>*>(nullptr),
+            column_fluid<Real>(), 0);
+    compare(static_cast<sphere::fluid_coupling<Real, sphere::host, gidaspow, cg, sphere::navier_stokes>*>(nullptr),
+            column_fluid<Real>(), 1);
+    compare(static_cast<sphere::fluid_coupling<Real, sphere::host, gidaspow, mg, sphere::darcy_flow>*>(nullptr), darcy, 2);
+    compare(static_cast<sphere::fluid_coupling<Real, sphere::host, gidaspow, cg, sphere::darcy_flow>*>(nullptr), darcy, 3);
+
+    // What it does not build is named, with where the setup came from.
+    const sphere::coupling_setup<Real> good = column_coupling<Real>().setup();
+    const auto refused = [&](void (*change)(sphere::coupling_setup<Real>&), const std::string& message) {
+        sphere::coupling_setup<Real> bad = good;
+        change(bad);
+        CHECK_THROWS_WITH((sphere::make_coupling<Real, sphere::host>(bad, grid, "checkpoint 'x': setup")),
+                          "sphere: checkpoint 'x': setup." + message);
+    };
+    refused([](sphere::coupling_setup<Real>& c) { c.model = "lattice_boltzmann"; },
+            "model = 'lattice_boltzmann': not one of 'navier_stokes', 'darcy'");
+    refused([](sphere::coupling_setup<Real>& c) { c.solver = "jacobi"; }, "solver = 'jacobi': not one of 'mg', 'cg'");
+    refused([](sphere::coupling_setup<Real>& c) { c.drag = "ergun"; },
+            "drag = 'ergun': couplings built from a setup use 'gidaspow' (others: build the fluid_coupling type in C++)");
+    // The model's own checks follow: a Darcy setup without a permeability.
+    sphere::coupling_setup<Real> no_permeability = good;
+    no_permeability.model = "darcy";
+    CHECK_THROWS_WITH((sphere::make_coupling<Real, sphere::host>(no_permeability, grid, "test")),
+                      Catch::Contains("permeability_prefactor = 0"));
 }

@@ -82,18 +82,21 @@ void describe_fluid(const sphere::coupling_setup<Real>& c, const sphere::fluid_s
     std::printf("fluid          density %g kg/m^3, viscosity %g Pa s, beta %g, gravity (%g, %g, %g) m/s^2\n",
                 double(f.density), double(f.viscosity), double(f.beta), double(f.gravity.x), double(f.gravity.y),
                 double(f.gravity.z));
-    const char* kinds[3] = {"no flow", "pressure", "inflow"};
     const sphere::fluid_boundary<Real>* ends[2] = {&f.bottom, &f.top};
     const char* names[2] = {"bottom", "top"};
     for (int e = 0; e < 2; ++e) {
         const auto& b = *ends[e];
-        std::printf("fluid %-8s %s", names[e], kinds[int(b.kind)]);
+        std::printf("fluid %-8s %s", names[e], sphere::name(b.kind));
         if (b.kind == sphere::fluid_boundary_kind::pressure)
             std::printf(" %g Pa (amplitude %g Pa, %g Hz)", double(b.pressure), double(b.amplitude),
                         double(b.frequency));
         if (b.kind == sphere::fluid_boundary_kind::inflow) std::printf(" %g m/s", double(b.velocity));
         std::printf("\n");
     }
+    std::printf("fluid solver   tolerance %g (%s), at most %u iterations\n", double(f.poisson.tolerance),
+                sphere::name(f.poisson.criterion), f.poisson.max_iterations);
+    std::printf("coupling       porosity %s, pressure force %s\n", sphere::name(c.options.porosity),
+                c.options.pressure_force ? "on" : "off");
     if (c.model == "darcy")
         std::printf("darcy          compressibility %g 1/Pa, permeability prefactor %g m^2, max porosity %g\n",
                     double(c.params.compressibility), double(c.params.permeability_prefactor),

@@ -25,6 +25,7 @@
 #include <optional>
 #include <string>
 #include <type_traits>
+#include <variant>
 
 #ifndef SPHERE_PROGRAM_VERSION
 #define SPHERE_PROGRAM_VERSION "unknown"
@@ -269,38 +270,10 @@ int run_coupled(const options& o, const std::string& run_name, const std::string
                              o.precision, " is not coupled to the pore fluid; use float or double");
     } else {
         const sphere::coupling_setup<Real> setup = sphere::coupling_setup<Real>::read(state, where.c_str());
-        if (setup.drag != sphere::drag::gidaspow::name())
-            sphere::detail::fail(where, ": the drag law ", setup.drag, "; the sphere program builds ",
-                                 sphere::drag::gidaspow::name(), " (others: restart from C++)");
-        sphere::world<Real> box;
-        for (int a = 0; a < 3; ++a) {
-            box.lo[a] = Real(state.lo[a]);
-            box.hi[a] = Real(state.hi[a]);
-        }
-        const sphere::fluid_grid<Real> grid = sphere::fluid_grid<Real>::make(box, state.n[0], state.n[1], state.n[2]);
         const std::string name = run_name + ", " + setup.model + " (" + setup.solver + ")";
-        const auto with = [&](auto* type, const auto& params) {
-            using Coupling = std::remove_pointer_t<decltype(type)>;
-            Coupling coupling(grid, params, setup.options);
-            return run_with<Sim>(o, name, bytes, input, &coupling);
-        };
-        using gidaspow = sphere::drag::gidaspow;
-        using mg = sphere::mg_poisson<Real, sphere::host>;
-        using cg = sphere::cg_poisson<Real, sphere::host>;
-        if (setup.model == "navier_stokes" && setup.solver == "mg")
-            return with(static_cast<sphere::fluid_coupling<Real, sphere::host, gidaspow, mg, sphere::navier_stokes>*>(nullptr),
-                        setup.params.fluid);
-        if (setup.model == "navier_stokes" && setup.solver == "cg")
-            return with(static_cast<sphere::fluid_coupling<Real, sphere::host, gidaspow, cg, sphere::navier_stokes>*>(nullptr),
-                        setup.params.fluid);
-        if (setup.model == "darcy" && setup.solver == "mg")
-            return with(static_cast<sphere::fluid_coupling<Real, sphere::host, gidaspow, mg, sphere::darcy_flow>*>(nullptr),
-                        setup.params);
-        if (setup.model == "darcy" && setup.solver == "cg")
-            return with(static_cast<sphere::fluid_coupling<Real, sphere::host, gidaspow, cg, sphere::darcy_flow>*>(nullptr),
-                        setup.params);
-        sphere::detail::fail(where, ": the model ", setup.model, " with the pressure solver ", setup.solver,
-                             "; the sphere program builds navier_stokes and darcy with mg or cg");
+        sphere::setup_coupling<Real, sphere::host> coupling =
+            sphere::make_coupling<Real, sphere::host>(setup, state.grid(), where + ": setup");
+        return std::visit([&](auto& c) { return run_with<Sim>(o, name, bytes, input, c.get()); }, coupling);
     }
 #endif
 }

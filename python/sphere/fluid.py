@@ -57,10 +57,9 @@ class Fluid:
         `simulation` (read from the same file with sphere.read_checkpoint) and restored from
         it: the sphere program's outputs of a coupled run read back. Raises sphere.Error for a
         file without a fluid section or setup, or a drag law other than Gidaspow's."""
-        path = os.fspath(path)
-        d = backend(simulation.precision).fluid_setup(path)
-        if d["drag"] != "gidaspow":
-            raise Error(f"sphere: checkpoint '{path}': the drag law {d['drag']}; sphere.Fluid builds gidaspow")
+        if not isinstance(simulation, Simulation):
+            raise TypeError(f"sphere.Fluid: simulation is a {type(simulation).__name__}; a sphere.Simulation is needed")
+        impl, d = backend(simulation.precision).fluid_from_checkpoint(simulation._impl, os.fspath(path))
 
         def end(name):
             return FluidBoundary(d[name + "_kind"], *(d[f"{name}_{field}"] for field in
@@ -73,8 +72,8 @@ class Fluid:
             compressibility=d["compressibility"], permeability_prefactor=d["permeability_prefactor"],
             max_porosity=d["max_porosity"], dem_steps=d["dem_steps"], pressure_force=d["pressure_force"],
             porosity=d["porosity_method"])
-        fluid = cls(simulation, d["cells"], settings)
-        fluid.restore(path)
+        fluid = cls.__new__(cls)
+        fluid._impl, fluid._sim, fluid._settings, fluid._history = impl, simulation, settings, []
         return fluid
 
     def __repr__(self):

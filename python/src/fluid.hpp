@@ -2,7 +2,8 @@
 // The class Fluid of one precision: the pore fluid coupled to a Simulation's particles
 // (sphere::fluid_coupling on the host backend with the Gidaspow drag law), which
 // python/sphere/fluid.py wraps. The model (navier_stokes or darcy) and the pressure solver (mg
-// or cg) are chosen at run time among the four couplings they make.
+// or cg) are chosen at run time: a FluidSettings becomes the library's coupling_setup, from
+// which sphere::make_coupling (fluid/setup_coupling.cuh) builds the coupling.
 #include "settings.hpp"
 
 #include <sphere/fluid.cuh>
@@ -21,19 +22,24 @@ namespace sphere_python {
 template <>
 inline const std::vector<std::string>& names_of<sphere::fluid_boundary_kind>()
 {
-    static const std::vector<std::string> names{"no_flow", "pressure", "inflow"};
+    using sphere::fluid_boundary_kind;
+    static const std::vector<std::string> names{sphere::name(fluid_boundary_kind::no_flow),
+                                                sphere::name(fluid_boundary_kind::pressure),
+                                                sphere::name(fluid_boundary_kind::inflow)};
     return names;
 }
 template <>
 inline const std::vector<std::string>& names_of<sphere::poisson_criterion>()
 {
-    static const std::vector<std::string> names{"relative_residual", "normalized_change"};
+    static const std::vector<std::string> names{sphere::name(sphere::poisson_criterion::relative_residual),
+                                                sphere::name(sphere::poisson_criterion::normalized_change)};
     return names;
 }
 template <>
 inline const std::vector<std::string>& names_of<sphere::porosity_method>()
 {
-    static const std::vector<std::string> names{"cell_volume", "cell_sphere"};
+    static const std::vector<std::string> names{sphere::name(sphere::porosity_method::cell_volume),
+                                                sphere::name(sphere::porosity_method::cell_sphere)};
     return names;
 }
 
@@ -78,6 +84,24 @@ sphere::fluid_params<Real> fluid_params_from(py::handle s)
     return p;
 }
 
+/// sphere.FluidSettings as the library's coupling_setup (the drag law Gidaspow's).
+template <class Real>
+sphere::coupling_setup<Real> setup_from(py::handle s)
+{
+    sphere::coupling_setup<Real> c;
+    c.model = s.attr("model").cast<std::string>();
+    c.solver = s.attr("solver").cast<std::string>();
+    c.drag = sphere::drag::gidaspow::name();
+    c.options.dem_steps = positive_count(s.attr("dem_steps"), "fluid.dem_steps");
+    c.options.pressure_force = flag(s.attr("pressure_force"), "fluid.pressure_force");
+    c.options.porosity = parse<sphere::porosity_method>(s.attr("porosity"), "fluid.porosity");
+    c.params.fluid = fluid_params_from<Real>(s);
+    c.params.compressibility = Real(number(s.attr("compressibility"), "fluid.compressibility"));
+    c.params.permeability_prefactor = Real(number(s.attr("permeability_prefactor"), "fluid.permeability_prefactor"));
+    c.params.max_porosity = Real(number(s.attr("max_porosity"), "fluid.max_porosity"));
+    return c;
+}
+
 /// Whether a fluid model type is the Darcy model.
 template <class Model>
 struct is_darcy_model : std::false_type {};
@@ -88,48 +112,33 @@ struct is_darcy_model<sphere::darcy_flow<Real, Policy, Poisson>> : std::true_typ
 template <class Real>
 class fluid_binding {
     using Sim = sphere::simulation<Real>;
-    using cg = sphere::cg_poisson<Real, sphere::host>;
-    using mg = sphere::mg_poisson<Real, sphere::host>;
-    template <class Poisson, template <class, class, class> class Model>
-    using coupling = sphere::fluid_coupling<Real, sphere::host, sphere::drag::gidaspow, Poisson, Model>;
-    using any_coupling =
-        std::variant<std::unique_ptr<coupling<mg, sphere::navier_stokes>>, std::unique_ptr<coupling<cg, sphere::navier_stokes>>,
-                     std::unique_ptr<coupling<mg, sphere::darcy_flow>>, std::unique_ptr<coupling<cg, sphere::darcy_flow>>>;
 
 public:
     /// A fluid on a grid of cells[0] x cells[1] x cells[2] cells over the simulation's world box,
     /// with the settings of a sphere.FluidSettings.
     fluid_binding(const Sim& sim, py::handle cells, py::handle s)
-        : grid_(grid_of(sim, cells)), model_(s.attr("model").cast<std::string>()),
-          solver_(s.attr("solver").cast<std::string>())
+        : fluid_binding(grid_of(sim, cells), setup_from<Real>(s), "fluid")
     {
-        sphere::coupling_options o;
-        o.dem_steps = positive_count(s.attr("dem_steps"), "fluid.dem_steps");
-        o.pressure_force = flag(s.attr("pressure_force"), "fluid.pressure_force");
-        o.porosity = parse<sphere::porosity_method>(s.attr("porosity"), "fluid.porosity");
-        const sphere::fluid_params<Real> fluid = fluid_params_from<Real>(s);
-        if (model_ != "navier_stokes" && model_ != "darcy")
-            sphere::detail::fail("fluid.model = '", model_, "': not one of 'navier_stokes', 'darcy'");
-        if (solver_ != "mg" && solver_ != "cg")
-            sphere::detail::fail("fluid.solver = '", solver_, "': not one of 'mg', 'cg'");
-        if (model_ == "navier_stokes") {
-            fluid.validate();
-            if (solver_ == "mg") c_ = std::make_unique<coupling<mg, sphere::navier_stokes>>(grid_, fluid, o);
-            else c_ = std::make_unique<coupling<cg, sphere::navier_stokes>>(grid_, fluid, o);
-        } else {
-            sphere::darcy_params<Real> d;
-            d.fluid = fluid;
-            d.compressibility = Real(number(s.attr("compressibility"), "fluid.compressibility"));
-            d.permeability_prefactor = Real(number(s.attr("permeability_prefactor"), "fluid.permeability_prefactor"));
-            d.max_porosity = Real(number(s.attr("max_porosity"), "fluid.max_porosity"));
-            d.validate();
-            if (solver_ == "mg") c_ = std::make_unique<coupling<mg, sphere::darcy_flow>>(grid_, d, o);
-            else c_ = std::make_unique<coupling<cg, sphere::darcy_flow>>(grid_, d, o);
-        }
     }
 
-    const std::string& model() const { return model_; }
-    const std::string& solver() const { return solver_; }
+    /// The fluid of a coupled run's checkpoint (read once): the coupling its setup describes on
+    /// its fluid section's cells over the simulation's world box, restored from it (which
+    /// checks the box); and the setup as a dict (setup_dict).
+    static py::tuple from_checkpoint(const Sim& sim, const std::string& path)
+    {
+        const sphere::checkpoint_data<Real> c = sphere::read_checkpoint<Real>(path);
+        if (!c.fluid) no_fluid_section(path, c.version);
+        const std::string where = "checkpoint '" + path + "'";
+        const sphere::coupling_setup<Real> setup = sphere::coupling_setup<Real>::read(*c.fluid, where.c_str());
+        const unsigned* n = c.fluid->n;
+        fluid_binding f(sphere::fluid_grid<Real>::make(sim.config().box, n[0], n[1], n[2]), setup, where + ": setup");
+        f.visit([&](auto& coupling) { coupling.restore(*c.fluid); });
+        py::dict d = setup_dict(setup, f.grid_);
+        return py::make_tuple(std::move(f), std::move(d));
+    }
+
+    const std::string& model() const { return setup_.model; }
+    const std::string& solver() const { return setup_.solver; }
     py::tuple cells() const { return py::make_tuple(grid_.n[0], grid_.n[1], grid_.n[2]); }
     py::tuple cell_width() const { return tuple3(grid_.width); }
     py::tuple lo() const { return tuple3(grid_.box.lo); }
@@ -218,14 +227,44 @@ public:
     void restore(const std::string& path)
     {
         const sphere::checkpoint_data<Real> c = sphere::read_checkpoint<Real>(path);
-        if (!c.fluid)
-            sphere::detail::fail("checkpoint '", path, "': no fluid section (format version ", c.version,
-                                 c.version >= 7 ? ", written without a fluid" : ", which has none",
-                                 "); Fluid.write_checkpoint writes one");
+        if (!c.fluid) no_fluid_section(path, c.version);
         visit([&](auto& coupling) { coupling.restore(*c.fluid); });
     }
 
 private:
+    fluid_binding(const sphere::fluid_grid<Real>& grid, const sphere::coupling_setup<Real>& setup,
+                  const std::string& where)
+        : grid_(grid), setup_(setup), c_(sphere::make_coupling<Real, sphere::host>(setup, grid, where))
+    {
+    }
+
+    [[noreturn]] static void no_fluid_section(const std::string& path, unsigned version)
+    {
+        sphere::detail::fail("checkpoint '", path, "': no fluid section (format version ", version,
+                             version >= 7 ? ", written without a fluid" : ", which has none",
+                             "); Fluid.write_checkpoint writes one");
+    }
+
+    /// A setup as a dict: model, solver, drag, cells, and every field of coupling_setup::fields
+    /// by its name (enumerations by name).
+    static py::dict setup_dict(const sphere::coupling_setup<Real>& setup, const sphere::fluid_grid<Real>& grid)
+    {
+        py::dict d;
+        d["model"] = setup.model;
+        d["solver"] = setup.solver;
+        d["drag"] = setup.drag;
+        d["cells"] = py::make_tuple(grid.n[0], grid.n[1], grid.n[2]);
+        sphere::coupling_setup<Real>::fields(
+            setup, [&](const char* name, const auto& field) { d[name] = double(field); },
+            [&](const char* name, const auto& field, std::uint64_t) {
+                using T = std::decay_t<decltype(field)>;
+                if constexpr (std::is_enum_v<T>) d[name] = name_of(field);
+                else if constexpr (std::is_same_v<T, bool>) d[name] = field;
+                else d[name] = std::uint64_t(field);
+            });
+        return d;
+    }
+
     static sphere::fluid_grid<Real> grid_of(const Sim& sim, py::handle cells)
     {
         if (!py::isinstance<py::sequence>(cells) || py::isinstance<py::str>(cells) || py::len(cells) != 3)
@@ -249,7 +288,7 @@ private:
 
     [[noreturn]] void wrong_model(const char* what, const char* needs, const char* instead) const
     {
-        sphere::detail::fail("fluid.", what, ": the ", needs, " model's field; this fluid is ", model_,
+        sphere::detail::fail("fluid.", what, ": the ", needs, " model's field; this fluid is ", setup_.model,
                              " (its field is ", instead, ")");
     }
 
@@ -282,43 +321,16 @@ private:
     }
 
     sphere::fluid_grid<Real> grid_;
-    std::string model_, solver_;
-    any_coupling c_;
+    sphere::coupling_setup<Real> setup_;
+    sphere::setup_coupling<Real, sphere::host> c_;
 };
 
-/// The setup of the coupled run a checkpoint holds (fluid/setup.cuh) as a dict: model, solver,
-/// drag, cells, and every field of coupling_setup::fields by its name (enumerations by name).
-template <class Real>
-py::dict fluid_setup_of(const std::string& path)
-{
-    const sphere::checkpoint_data<Real> c = sphere::read_checkpoint<Real>(path);
-    if (!c.fluid)
-        sphere::detail::fail("checkpoint '", path, "': no fluid section (format version ", c.version,
-                             "); Fluid.write_checkpoint writes one");
-    const std::string where = "checkpoint '" + path + "'";
-    const sphere::coupling_setup<Real> setup = sphere::coupling_setup<Real>::read(*c.fluid, where.c_str());
-    py::dict d;
-    d["model"] = setup.model;
-    d["solver"] = setup.solver;
-    d["drag"] = setup.drag;
-    d["cells"] = py::make_tuple(c.fluid->n[0], c.fluid->n[1], c.fluid->n[2]);
-    sphere::coupling_setup<Real>::fields(
-        setup, [&](const char* name, const auto& field) { d[name] = double(field); },
-        [&](const char* name, const auto& field, std::uint64_t) {
-            using T = std::decay_t<decltype(field)>;
-            if constexpr (std::is_enum_v<T>) d[name] = name_of(field);
-            else if constexpr (std::is_same_v<T, bool>) d[name] = field;
-            else d[name] = std::uint64_t(field);
-        });
-    return d;
-}
-
-/// Binds fluid_binding<Real> as `Fluid` into m, and fluid_setup.
+/// Binds fluid_binding<Real> as `Fluid` into m, and fluid_from_checkpoint.
 template <class Real>
 void bind_fluid(py::module_& m)
 {
-    m.def("fluid_setup", &fluid_setup_of<Real>, py::arg("path"));
     using F = fluid_binding<Real>;
+    m.def("fluid_from_checkpoint", &F::from_checkpoint, py::arg("simulation"), py::arg("path"));
     using Sim = sphere::simulation<Real>;
     py::class_<F>(m, "Fluid", "the pore fluid coupled to a simulation (sphere::fluid_coupling, host backend)")
         .def(py::init<const Sim&, py::handle, py::handle>(), py::arg("simulation"), py::arg("cells"),

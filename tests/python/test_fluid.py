@@ -142,6 +142,18 @@ def test_a_coupled_run_continues_from_its_checkpoint_bit_for_bit(precision, mode
         sphere.Fluid(again, (2, 2, 6), settings).restore(plain)
     with pytest.raises(sphere.Error, match="grid has 2 x 2 x 6 cells, this one 2 x 2 x 5"):
         sphere.Fluid(again, (2, 2, 5), settings).restore(path)
+    # From the checkpoint alone (its stored setup): the fluid restore() gives; on a simulation
+    # of another box, refused.
+    fresh = sphere.Fluid(sphere.read_checkpoint(path), (2, 2, 6), settings)
+    fresh.restore(path)
+    built = sphere.Fluid.from_checkpoint(sphere.read_checkpoint(path), path)
+    assert (built.model, built.settings.solver, built.cells, built.dem_steps) == (fresh.model, fresh.settings.solver,
+                                                                                  fresh.cells, fresh.dem_steps)
+    assert built.time == fresh.time and np.array_equal(built.pressure(), fresh.pressure())
+    taller = sphere.Simulation(linear_settings(hi=(0.02, 0.02, 0.08), k_n=1.0, boundary=("periodic", "periodic", "wall")),
+                               [[0.01, 0.01, 0.01]], RADIUS, 2600, precision=precision)
+    with pytest.raises(sphere.Error, match=r"grid spans \[0, 0.0(6|59+\d*)\] m along z, this one \[0, 0.0(8|79+\d*|80+\d*)\] m"):
+        sphere.Fluid.from_checkpoint(taller, path)
 
 
 def test_figures_show_the_profiles_and_the_solves(tmp_path):
@@ -226,6 +238,9 @@ def test_the_program_runs_a_coupled_checkpoint_as_the_process_does(model, solver
                          text=True, check=True).stdout
     assert f"fluid          {model} ({solver} pressure solver, gidaspow drag), 2 x 2 x 6 cells" in dry
     assert "fluid step     10 DEM steps" in dry
+    assert "fluid bottom   no_flow" in dry
+    assert f"fluid solver   tolerance {settings.tolerance:g} (relative_residual), at most {settings.max_iterations}" in dry
+    assert "coupling       porosity cell_volume, pressure force on" in dry
     done = sphere.run_program(tmp_path / "coupled.ck", total, interval=2 * fluid.dt, out=tmp_path / "out",
                               program=program)
     outputs = sorted((tmp_path / "out").glob("coupled.output*.ck"))

@@ -20,6 +20,17 @@ enum class fluid_boundary_kind {
               ///< gradient of the pressure increment); the other end must prescribe the pressure
 };
 
+/// A boundary kind's name as written in C++ ("no_flow", "pressure", "inflow").
+inline const char* name(fluid_boundary_kind k)
+{
+    switch (k) {
+    case fluid_boundary_kind::no_flow: return "no_flow";
+    case fluid_boundary_kind::pressure: return "pressure";
+    case fluid_boundary_kind::inflow: return "inflow";
+    }
+    return "?";
+}
+
 /// One z end of the fluid grid. For `pressure`, the value at time t is
 ///   p(t) = pressure + amplitude sin(2 pi frequency t + phase)   (Pa).
 /// For `inflow`, `velocity` is the superficial velocity U = phi w through the end face (m/s,
@@ -89,7 +100,7 @@ struct fluid_params {
             if (b.kind == fluid_boundary_kind::inflow && other.kind != fluid_boundary_kind::pressure)
                 detail::fail("fluid: an inflow ", names[e], " (velocity ", b.velocity, " m/s) needs a prescribed pressure at the ",
                              names[1 - e], ", where the fluid can leave or enter; it is ",
-                             other.kind == fluid_boundary_kind::no_flow ? "no_flow" : "inflow");
+                             name(other.kind));
         }
     }
 };

@@ -115,6 +115,12 @@ enum class poisson_criterion {
     normalized_change, ///< max (eps_new - eps_old)^2 / eps_new^2 <= tolerance (the seeds')
 };
 
+/// A criterion's name as written in C++ ("relative_residual", "normalized_change").
+inline const char* name(poisson_criterion c)
+{
+    return c == poisson_criterion::normalized_change ? "normalized_change" : "relative_residual";
+}
+
 /// Settings of one solve.
 struct poisson_settings {
     double tolerance = 1e-8;          ///< threshold of the criterion; positive and finite

@@ -37,6 +37,12 @@ enum class porosity_method {
     cell_sphere
 };
 
+/// A method's name as written in C++ ("cell_volume", "cell_sphere").
+inline const char* name(porosity_method m)
+{
+    return m == porosity_method::cell_sphere ? "cell_sphere" : "cell_volume";
+}
+
 /// Kernel view of the estimator's fields, each in the fluid grid's field layout
 /// (`fluid_grid::field_index`, ghost nodes included; the estimator writes the cells only).
 template <class Real>
@@ -379,10 +385,9 @@ public:
         for (const char* name : {"phi", "dphi_dt", "d_p"}) s.array_named(who, name, size, what);
         s.array_named(who, "v_p", 3 * size, "3 per node of the grid's fields");
         s.count_named(who, "have_previous", 1);
-        const bool sphere = s.count_named(who, "method", 1) == 1;
-        if (sphere != (method_ == porosity_method::cell_sphere))
-            detail::fail(who, ": the snapshot's porosity method is ", sphere ? "cell_sphere" : "cell_volume",
-                         ", this estimator's ", sphere ? "cell_volume" : "cell_sphere");
+        const auto stored = static_cast<porosity_method>(s.count_named(who, "method", 1));
+        if (stored != method_)
+            detail::fail(who, ": the snapshot's porosity method is ", name(stored), ", this estimator's ", name(method_));
     }
 
     /// Continues from a snapshot() of an estimator of the same grid and method: the next update

@@ -14,6 +14,7 @@
 #include <utility>
 #include <vector>
 
+#include "../boundary/world.cuh"
 #include "../core/error.cuh"
 #include "../core/vec.cuh"
 #include "grid.cuh"
@@ -59,6 +60,17 @@ struct fluid_snapshot {
             s.hi[a] = double(g.box.hi[a]);
         }
         return s;
+    }
+
+    /// The grid the snapshot was taken on (its cells and box).
+    fluid_grid<Real> grid() const
+    {
+        world<Real> box;
+        for (int a = 0; a < 3; ++a) {
+            box.lo[a] = Real(lo[a]);
+            box.hi[a] = Real(hi[a]);
+        }
+        return fluid_grid<Real>::make(box, n[0], n[1], n[2]);
     }
 
     void add(const std::string& name, std::vector<Real> values) { arrays.push_back({name, std::move(values)}); }
