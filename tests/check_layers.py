@@ -9,11 +9,16 @@ without `/` or `.cuh`. The last column lists, comma-separated, the rows its head
 ("nothing" for none, "all" for every row above). A header may include headers of its own row
 and of the rows its row lists; every listed row must lie above it, and must really be included
 (so the table cannot claim more than the code does). Dispatch on the execution policy
-(`is_same<Policy, ...>`) belongs in exec/ alone. Exits 1 with one line per violation.
+(`is_same<Policy, ...>`) belongs in exec/ alone, and CUDA-only code (CUDA_ONLY below) in core/
+and exec/ alone. Exits 1 with one line per violation.
 """
 import pathlib
 import re
 import sys
+
+
+# What compiles only under nvcc: the compiler's macros, the CUDA runtime, Thrust and CUB.
+CUDA_ONLY = r"__CUDACC__|__CUDA_ARCH__|cuda_runtime|\bcub::|\bthrust::|<cub/|<thrust/"
 
 
 def parse_table(architecture):
@@ -90,6 +95,9 @@ def main(root):
                                     f"which row '{own}' does not list")
             if own != "exec" and re.search(r"is_same(_v)?\s*<\s*Policy\b", line):
                 problems.append(f"include/sphere/{header}:{number}: dispatches on the policy outside exec/")
+            if own not in ("core", "exec") and re.search(CUDA_ONLY, line):
+                problems.append(f"include/sphere/{header}:{number}: CUDA-only code outside core/ and exec/ "
+                                "(tests/CMakeLists.txt compiles only those headers one by one with nvcc)")
     for name, _, deps in rows:
         if deps not in (["all"], ["nothing"]):
             for d in sorted(allowed[name] - used[name]):

@@ -36,9 +36,12 @@
 
 /// SPHERE_UNROLL before a loop with a constant trip count whose index selects struct members
 /// (the six wall faces): unrolled, every index is a constant and the members stay in
-/// registers on CUDA instead of local memory (nvcc's host pass, g++, gets g++'s pragma).
+/// registers on CUDA instead of local memory. g++ gets its own pragma; nvcc's host pass none
+/// (its front end warns about g++'s, and g++ about nvcc's).
 #if defined(__CUDA_ARCH__)
 #define SPHERE_UNROLL _Pragma("unroll")
+#elif defined(__CUDACC__)
+#define SPHERE_UNROLL
 #elif defined(__GNUC__) && !defined(__clang__)
 #define SPHERE_UNROLL _Pragma("GCC unroll 8")
 #else
