@@ -8,6 +8,7 @@
 /// Host-only code (the couplings themselves run on `Policy`).
 #include <memory>
 #include <string>
+#include <type_traits>
 #include <variant>
 
 #include "../core/error.cuh"
