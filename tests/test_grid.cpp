@@ -657,13 +657,24 @@ TEMPLATE_TEST_CASE("the grid numbers the axis with the most cells slowest", "[gr
         box.hi = {Real(0.0552), Real(0.0552), Real(0.034)};
         box.axis[0] = box.axis[1] = boundary::periodic;
         const auto g = sphere::grid_geometry<Real>::make(box, Real(0.0026), Real(0));
-        CHECK(g.n[0] == 21);
+        // 21 cells of at least 2.6 mm fit along x and y; the slow axis's count is rounded
+        // down to a multiple of 4 (even shares of the slab schedule's phases)
+        CHECK(g.n[0] == 20);
+        CHECK(g.n[1] == 21);
         CHECK(g.n[2] == 13);
+        CHECK(g.width[0] == Approx(0.0552 / 20));
         CHECK(g.slow == 0);
         CHECK(g.mid == 1);
         CHECK(g.fast == 2);
-        CHECK(g.layers() == 21);
+        CHECK(g.layers() == 20);
         CHECK(g.cells_per_layer() == 21 * 13);
+        // a requested cell width is kept as it is
+        const auto exact = sphere::grid_geometry<Real>::make(box, Real(0.0026), Real(0.0026));
+        CHECK(exact.n[0] == 21);
+        CHECK(exact.layers() == 21);
+        // fewer than 16 cells are not rounded: a wider world of 15 cells keeps them
+        box.hi.x = Real(0.0026 * 15.5);
+        CHECK(sphere::grid_geometry<Real>::make(box, Real(0.0026), Real(0)).n[0] == 15);
     }
     SECTION("a tall closed column: z slowest")
     {
@@ -737,12 +748,21 @@ TEST_CASE("the slab phases let no two tasks of a phase write the same layer", "[
                     }
                     CHECK(tasks <= 1);
                 }
-                // Each thread's share is a contiguous range, and the shares cover the phase.
+                // Each thread's share is a contiguous range, the shares cover the phase, and
+                // each holds its part of the phase's entries to within one task's.
+                double total = 0, largest = 0;
+                for (const auto& task : phases.phase[ph]) {
+                    total += phases.work(task);
+                    largest = std::max(largest, phases.work(task));
+                }
                 for (int threads = 1; threads <= 5; ++threads) {
                     std::size_t next = 0;
                     for (int t = 0; t < threads; ++t) {
                         std::size_t first, end;
                         phases.share(ph, t, threads, first, end);
+                        double mine = 0;
+                        for (std::size_t k = first; k < end; ++k) mine += phases.work(phases.phase[ph][k]);
+                        CHECK(std::abs(mine - total / threads) <= largest);
                         if (first >= end) continue;
                         CHECK(first == next);
                         next = end;
@@ -765,7 +785,7 @@ TEMPLATE_TEST_CASE("every cell's start is the number of particles in lower cells
     box.lo = {0, 0, 0};
     box.hi = {Real(0.004), Real(0.004), Real(2.0)};
     const auto g = sphere::grid_geometry<Real>::make(box, Real(0.001), Real(0));
-    REQUIRE(g.cell_count() >= 4u * 4u * 1999u); // 1999 layers in float, 2000 in double
+    REQUIRE(g.cell_count() >= 4u * 4u * 1996u); // 1999 layers in float (rounded to 1996), 2000 in double
     std::size_t n = 0;
     SECTION("no particles") { n = 0; }
     SECTION("a settled sample") { n = 300; }

@@ -260,7 +260,7 @@ TEMPLATE_TEST_CASE("rolling: the energy budget of a damped, rolling pile closes"
     // resistance between particles and at walls, at dt = the default / 4 for 0.5 s, sampled every
     // 800 steps: energy().total() (kinetic, rotational, potential, springs, dissipated) stays
     // within 2e-3 of the potential energy the pile loses, as for the other laws, with rolling
-    // and twisting springs loaded at the end. (The frictional dissipation booked may go
+    // and twisting springs loaded in the contacts at the end. (The frictional dissipation booked may go
     // negative here, as for the tangential spring: docs/physics.md, "Rolling and twisting
     // resistance".)
     using Real = user_real<TestType>;
@@ -296,8 +296,12 @@ TEMPLATE_TEST_CASE("rolling: the energy budget of a damped, rolling pile closes"
         rolling += t.lane[4 * e] != Real(0) || t.lane[4 * e + 1] != Real(0);
         twisting += t.lane[4 * e + 3] != Real(0);
     }
-    CHECK(rolling > 10);
-    CHECK(twisting > 10);
+    // The pile ends with 10-13 pair contacts (float, double and mixed sum in different
+    // orders and settle differently); nearly all carry loaded springs.
+    INFO(t.partner.size() << " contacts, " << rolling << " with a rolling, " << twisting << " with a twisting spring");
+    CHECK(t.partner.size() >= 8);
+    CHECK(rolling >= 0.8 * double(t.partner.size()));
+    CHECK(twisting >= 0.8 * double(t.partner.size()));
 }
 
 TEMPLATE_TEST_CASE("rolling: a checkpoint keeps the angles and restarts bit for bit", "[rolling][io]", double,

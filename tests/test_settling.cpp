@@ -120,8 +120,9 @@ TEMPLATE_TEST_CASE("a polydisperse bed settles under gravity to rest with a clos
 {
     using Real = TestType;
     // 12 x 12 x 16 = 2304 particles; the top layer falls ~15 mm, the bed is at rest
-    // after ~0.2 s (measured kinetic + rotational energy ~1e-6 of the released at 0.25 s).
-    const bed_result r = settle<Real>(12, 16, 0.25, 0.075);
+    // after ~0.25 s (measured kinetic + rotational energy ~1e-6 of the released at 0.3 s; a
+    // late rearrangement, which the order of the sums decides, can keep it moving at 0.25 s).
+    const bed_result r = settle<Real>(12, 16, 0.3, 0.075);
     INFO(r.size << " particles, " << r.steps << " steps in " << r.seconds << " s; released " << r.released
                 << " J; budget error at the end " << r.final_budget / r.released << ", largest "
                 << r.max_budget / r.released << " of the released; kinetic + rotational " << r.moving / r.released

@@ -87,7 +87,7 @@ struct particle_energy {
                 const Coord dist2 = norm2(d), reach = xi.w + xj.w;
                 if (!law_acts<Law>(pair_params, dist2, reach)) continue;
                 contact_geometry<Real> g;
-                pair_geometry<materials>(g, p, i, j, d, dist2, xi.w, xj.w);
+                pair_geometry<materials>(g, p, i, j, separation_of<Real>(d, dist2, xi.w, xj.w));
                 law_history_t<Law, Real> h;
                 c.history.load(k, h);
                 e.elastic += Coord(Law::pair_energy(pair_params, g, h));

@@ -41,23 +41,44 @@ struct wall_loads {
     }
 };
 
-/// The normal overlap-distance delta_n = |d| - reach (m, negative in contact) from a
-/// separation d, its squared length dist2 and the sum of radii, and the unit normal d / |d|.
-/// When positions are held in a wider type than the contact law's (precision mixed), the
-/// difference dist2 - reach^2 is formed in that type and divided by |d| + reach in the narrow
-/// one: the overlap keeps its relative precision although |d| and reach agree to 1e-5.
+/// A pair's separation as the contact law's arithmetic needs it: d = x_i - x_j (the nearest
+/// image, m) and the radii (m) in the law's type Real, and, when positions are held in a wider
+/// type Coord (precision mixed), the overlap's numerator excess = dist2 - (r_i + r_j)^2 (m^2)
+/// formed in that type, where |d| and r_i + r_j still differ in their last digits.
+template <class Real>
+struct pair_separation {
+    vec3<Real> d;
+    Real r_i, r_j;
+    Real excess; ///< unused (0) when Real is Coord
+};
+
+/// The separation of a pair whose positions (type Coord) are d = x_i - x_j apart, dist2 = |d|^2,
+/// with radii r_i and r_j.
 template <class Real, class Coord>
-SPHERE_HDI Real overlap_and_normal(const vec3<Coord>& d, Coord dist2, Coord reach, vec3<Real>& n)
+SPHERE_HDI pair_separation<Real> separation_of(const vec3<Coord>& d, Coord dist2, Coord r_i, Coord r_j)
 {
-    if constexpr (std::is_same_v<Real, Coord>) {
-        const Real dist = std::sqrt(dist2);
-        n = d * (Real(1) / dist);
+    pair_separation<Real> s;
+    s.d = vec_cast<Real>(d);
+    s.r_i = Real(r_i);
+    s.r_j = Real(r_j);
+    const Coord reach = r_i + r_j;
+    s.excess = std::is_same_v<Real, Coord> ? Real(0) : Real(dist2 - reach * reach);
+    return s;
+}
+
+/// The normal overlap-distance delta_n = |d| - reach (m, negative in contact) of a separation
+/// s, and the unit normal d / |d|. When positions are held in a wider type Coord than the
+/// contact law's (precision mixed), delta_n = excess / (|d| + reach), the difference formed in
+/// the wide type: the overlap keeps its relative precision although |d| and reach agree to 1e-5.
+template <class Coord, class Real>
+SPHERE_HDI Real overlap_and_normal(const pair_separation<Real>& s, vec3<Real>& n)
+{
+    const Real dist = std::sqrt(norm2(s.d)), reach = s.r_i + s.r_j;
+    n = s.d * (Real(1) / dist);
+    if constexpr (std::is_same_v<Real, Coord>)
         return dist - reach;
-    } else {
-        const Real dist = std::sqrt(Real(dist2));
-        n = vec_cast<Real>(d) * (Real(1) / dist);
-        return Real(dist2 - reach * reach) / (dist + Real(reach));
-    }
+    else
+        return s.excess / (dist + reach);
 }
 
 /// Whether Law with kernel parameters `params` acts on a pair at squared distance dist2 (m^2)
@@ -71,16 +92,15 @@ SPHERE_HDI bool law_acts(const KernelParams& params, Coord dist2, Coord reach)
 }
 
 /// Fills the geometry g of the contact of particles i and j of p, as seen by i, from their
-/// separation d (m), its squared length dist2 and their radii; with `Materials` (a law that
-/// tells materials apart, contact/law.cuh) their material indices too, else 0.
-template <bool Materials, class P, class Coord>
+/// separation s; with `Materials` (a law that tells materials apart, contact/law.cuh) their
+/// material indices too, else 0.
+template <bool Materials, class P>
 SPHERE_HDI void pair_geometry(contact_geometry<real_t<P>>& g, const particle_view<P>& p, std::size_t i, std::size_t j,
-                              const vec3<Coord>& d, Coord dist2, Coord r_i, Coord r_j)
+                              const pair_separation<real_t<P>>& s)
 {
-    using Real = real_t<P>;
-    g.delta_n = overlap_and_normal(d, dist2, r_i + r_j, g.n);
-    g.r_i = Real(r_i);
-    g.r_j = Real(r_j);
+    g.delta_n = overlap_and_normal<coord_t<P>>(s, g.n);
+    g.r_i = s.r_i;
+    g.r_j = s.r_j;
     g.r_eff = g.r_i * g.r_j / (g.r_i + g.r_j);
     g.m_i = p.mass[i];
     g.m_j = p.mass[j];
@@ -141,27 +161,29 @@ struct pair_contact {
 
     /// The contact of i (owner) and j (slots) with history h (updated): both particles'
     /// share, or zero when the law does not act on them (acts()), which also resets the
-    /// history. `Branchless` evaluates the law whatever the distance and selects the
-    /// result, so that a loop over pairs vectorises (non-touching pairs may then produce
-    /// non-finite intermediates, which are discarded); otherwise non-touching pairs return
-    /// early.
-    template <bool Branchless>
+    /// history.
     SPHERE_HDI pair_result<Real> evaluate(std::size_t i, std::size_t j, history_type& h) const
     {
         const vec4<Coord> xi = p.x[i], xj = p.x[j];
         vec3<Coord> d = box.nearest_image_inside(xi.xyz() - xj.xyz());
-        const Coord dist2 = norm2(d), reach = xi.w + xj.w;
-        const bool touching = acts(dist2, reach);
-        if constexpr (!Branchless) {
-            if (!touching) {
-                h = history_type{}; // a contact that has ended forgets its history
-                return {};
-            }
+        const Coord dist2 = norm2(d);
+        if (!acts(dist2, xi.w + xj.w)) {
+            h = history_type{}; // a contact that has ended forgets its history
+            return {};
         }
+        return evaluate_touching(i, j, separation_of<Real>(d, dist2, xi.w, xj.w), h);
+    }
+
+    /// The contact of i (owner) and j with separation s, on which the law acts (acts()), with
+    /// history h (updated): both particles' share. For callers that have the separation already
+    /// (the SIMD tiles of contact/interact.cuh).
+    SPHERE_HDI pair_result<Real> evaluate_touching(std::size_t i, std::size_t j, const pair_separation<Real>& s,
+                                                   history_type& h) const
+    {
         contact_motion<Real> m;
-        pair_geometry<materials>(m, p, i, j, d, dist2, xi.w, xj.w);
+        pair_geometry<materials>(m, p, i, j, s);
         vec3<Real> n = m.n; // not const: see the note at the top
-        const Real arm_i = Real(xi.w) + m.delta_n / 2, arm_j = Real(xj.w) + m.delta_n / 2;
+        const Real arm_i = s.r_i + m.delta_n / 2, arm_j = s.r_j + m.delta_n / 2;
         m.velocity = p.v_sync[i] - p.v_sync[j] + arm_i * cross(n, p.omega_sync[i]) + arm_j * cross(n, p.omega_sync[j]);
         m.step = OneVelocity ? m.velocity * dt
                              : (p.v[i] - p.v[j]) * dt + arm_i * cross(n, p.omega[i] * dt) +
@@ -179,17 +201,6 @@ struct pair_contact {
         r.visc_rate = c.visc_rate;
         r.fric_rate = c.fric_rate;
         r.record = {c.tangential.x, c.tangential.y, c.tangential.z, dot(c.normal, n)};
-        if constexpr (Branchless) {
-            const vec3<Real> zero{0, 0, 0};
-            r.force = select(touching, r.force, zero);
-            r.torque_i = select(touching, r.torque_i, zero);
-            r.torque_j = select(touching, r.torque_j, zero);
-            r.fn = touching ? r.fn : Real(0);
-            r.visc_rate = touching ? r.visc_rate : Real(0);
-            r.fric_rate = touching ? r.fric_rate : Real(0);
-            r.record = select(touching, r.record, vec4<Real>{0, 0, 0, 0});
-            updated = select(touching, updated, history_type{});
-        }
         h = updated;
         return r;
     }

@@ -46,13 +46,16 @@ struct zero_pair_sums {
 };
 
 /// A tile of pair contacts evaluated together in SIMD lanes: lanes [0, count) hold pairs,
-/// the rest repeat lane 0 and are discarded. `Lanes`: the contact law's history lanes
+/// the rest repeat lane 0 and are discarded. The row walk fills in each pair's separation and
+/// radii, which it has read to sort out pairs apart, so that the SIMD loop does not gather the
+/// positions again. `Lanes`: the contact law's history lanes
 /// (contact/history.cuh).
 template <class Real, unsigned Lanes>
 struct pair_tile {
     static constexpr int width = 16;
     int count = 0;
     unsigned owner[width], partner[width], entry[width];
+    Real dx[width], dy[width], dz[width], r_i[width], r_j[width], excess[width]; ///< pair_separation
     Real fx[width], fy[width], fz[width];
     Real tix[width], tiy[width], tiz[width], tjx[width], tjy[width], tjz[width];
     Real hx[width], hy[width], hz[width], hw[width];
@@ -89,21 +92,23 @@ struct slab_pairs {
                 // the sliding flag goes into the tile here: the SIMD loop gathers the
                 // displacements, but cannot gather bytes
                 t.hw[t.count] = Real(c.history.flags[e]);
-                if constexpr (touching_lanes_only) {
-                    // Only touching pairs take a lane; the others only forget their history.
-                    // Both lists grow without a branch on the outcome, which no predictor
-                    // could guess.
-                    const vec4<Coord> xj = p.x[j];
-                    vec3<Coord> d = eval.box.nearest_image_inside(xi.xyz() - xj.xyz());
-                    const Coord dist2 = norm2(d), reach = xi.w + xj.w;
-                    const bool touching = eval.acts(dist2, reach);
-                    apart[apart_count] = e;
-                    t.count += touching;
-                    apart_count += !touching;
-                    if (apart_count == tile::width) forget(apart, apart_count);
-                } else {
-                    ++t.count;
-                }
+                const vec4<Coord> xj = p.x[j];
+                vec3<Coord> d = eval.box.nearest_image_inside(xi.xyz() - xj.xyz());
+                const Coord dist2 = norm2(d);
+                const pair_separation<Real> s = separation_of<Real>(d, dist2, xi.w, xj.w);
+                t.dx[t.count] = s.d.x;
+                t.dy[t.count] = s.d.y;
+                t.dz[t.count] = s.d.z;
+                t.r_i[t.count] = s.r_i;
+                t.r_j[t.count] = s.r_j;
+                t.excess[t.count] = s.excess;
+                // Only touching pairs take a lane; the others only forget their history. Both
+                // lists grow without a branch on the outcome, which no predictor could guess.
+                const bool touching = eval.acts(dist2, xi.w + xj.w);
+                apart[apart_count] = e;
+                t.count += touching;
+                apart_count += !touching;
+                if (apart_count == tile::width) forget(apart, apart_count);
                 if (t.count == tile::width) flush(t);
             }
         }
@@ -116,12 +121,6 @@ private:
     using history_type = law_history_t<Law, Real>;
     static constexpr unsigned lanes = law_history_shape<Law>::value.lanes;
     using tile = pair_tile<Real, lanes>;
-
-    /// Whether pairs that do not touch are sorted out before the SIMD tiles (where they would
-    /// take a lane and add zeros to both particles): 7% faster on the dense bed in double and
-    /// 3% in float, where about 40% of the listed pairs do not touch, but 3% slower in mixed,
-    /// whose float lanes are cheap next to the test in double (docs/performance.md).
-    static constexpr bool touching_lanes_only = std::is_same_v<Real, Coord>;
 
     /// The entries of pairs that do not touch: no force, and the history is forgotten.
     void forget(const unsigned* entry, int& count) const
@@ -141,6 +140,12 @@ private:
             t.partner[k] = t.partner[0];
             t.entry[k] = t.entry[0];
             t.hw[k] = t.hw[0];
+            t.dx[k] = t.dx[0];
+            t.dy[k] = t.dy[0];
+            t.dz[k] = t.dz[0];
+            t.r_i[k] = t.r_i[0];
+            t.r_j[k] = t.r_j[0];
+            t.excess[k] = t.excess[0];
         }
         // Local copies: loop invariants the compiler can keep in registers.
         pair_contact<P, Law, OneVelocity> pairs = eval;
@@ -148,12 +153,17 @@ private:
         const Real* lane = c.history.lane;
         SPHERE_VECTORISE_LOOP
         for (int k = 0; k < w; ++k) {
-            const vec3<Real> d = shift[t.entry[k]];
+            const vec3<Real> s = shift[t.entry[k]];
             history_type h;
-            history_base(h) = {d.x, d.y, d.z, t.hw[k]};
+            history_base(h) = {s.x, s.y, s.z, t.hw[k]};
             if constexpr (lanes > 0)
                 for (unsigned l = 0; l < lanes; ++l) h.lane[l] = lane[t.entry[k] * lanes + l];
-            pair_result<Real> r = pairs.template evaluate<true>(t.owner[k], t.partner[k], h);
+            pair_separation<Real> sep;
+            sep.d = {t.dx[k], t.dy[k], t.dz[k]};
+            sep.r_i = t.r_i[k];
+            sep.r_j = t.r_j[k];
+            sep.excess = t.excess[k];
+            pair_result<Real> r = pairs.evaluate_touching(t.owner[k], t.partner[k], sep, h);
             t.fx[k] = r.force.x;
             t.fy[k] = r.force.y;
             t.fz[k] = r.force.z;
@@ -214,14 +224,14 @@ private:
 /// layers, phase 1 the odd ones; on a periodic axis with an odd number of layers the last
 /// layer (which writes the first) joins the task of layer 0.
 ///
-/// The threads share the layers in contiguous blocks of about equal work (entries); a thread
-/// runs the tasks of both phases that start in its block, and then whatever comes after the
-/// pair sums for the particles of its block, whose forces it mostly summed itself.
+/// The threads share each phase's tasks in contiguous ranges of about equal work (entries),
+/// phase by phase: the tasks of a phase write disjoint layers, so any split of them gives the
+/// same sums. After the pair sums, a thread runs whatever comes after them for the particles
+/// of its block of layers (about equal entries of both phases together).
 struct slab_phases {
     struct task {
         unsigned layer[2];
         unsigned layers;
-        unsigned home; ///< the layer whose block decides the thread (tasks are in order of it)
     };
     std::vector<task> phase[2];
     std::vector<unsigned> entries; ///< entries of the layers before each layer (layer_entries)
@@ -230,8 +240,8 @@ struct slab_phases {
     {
         const unsigned n = layers();
         const bool merge_last = periodic && n >= 3 && n % 2 == 1;
-        for (unsigned l = merge_last ? 1 : 0; l < (merge_last ? n - 1 : n); ++l) phase[l % 2].push_back({{l, 0}, 1, l});
-        if (merge_last) phase[0].push_back({{n - 1, 0}, 2, n - 1}); // its thread is the one of the last layer
+        for (unsigned l = merge_last ? 1 : 0; l < (merge_last ? n - 1 : n); ++l) phase[l % 2].push_back({{l, 0}, 1});
+        if (merge_last) phase[0].push_back({{n - 1, 0}, 2});
     }
 
     unsigned layers() const { return static_cast<unsigned>(entries.size() - 1); }
@@ -257,22 +267,35 @@ struct slab_phases {
         if (first > end) first = end;
     }
 
-    /// Thread t's tasks of phase ph: a contiguous range, those whose home layer lies in its block.
+    /// Thread t's tasks of phase ph among `threads`: the tasks whose middle entry falls in its
+    /// share of the phase's entries.
     void share(int ph, int t, int threads, std::size_t& first, std::size_t& end) const
     {
-        unsigned lo, hi;
-        block(t, threads, lo, hi);
         const std::vector<task>& tasks = phase[ph];
+        double total = 0;
+        for (const task& k : tasks) total += work(k);
         first = end = tasks.size();
+        double before = 0;
         for (std::size_t k = 0; k < tasks.size(); ++k) {
-            const bool mine = tasks[k].home >= lo && tasks[k].home < hi;
-            if (mine && first == tasks.size()) first = k;
-            if (tasks[k].home >= hi) {
+            const double middle = before + work(tasks[k]) / 2;
+            int o = total > 0 ? static_cast<int>(middle * threads / total) : 0;
+            if (o >= threads) o = threads - 1;
+            if (o == t && first == tasks.size()) first = k;
+            if (o > t) {
                 end = k;
                 break;
             }
+            before += work(tasks[k]);
         }
         if (first > end) first = end;
+    }
+
+    /// The entries of a task's layers.
+    double work(const task& k) const
+    {
+        double sum = 0;
+        for (unsigned m = 0; m < k.layers; ++m) sum += double(entries[k.layer[m] + 1] - entries[k.layer[m]]);
+        return sum;
     }
 };
 
@@ -350,7 +373,7 @@ struct evaluate_owned_pairs {
             if (j >= wall_partner_base) break;
             law_history_t<Law, Real> h;
             c.history.load(e, h);
-            pair_result<Real> res = eval.template evaluate<false>(i, j, h);
+            pair_result<Real> res = eval.evaluate(i, j, h);
             if (update_history) c.history.store(e, h);
             if (Record) c.force[e] = res.record;
             force[e] = res.force;

@@ -63,7 +63,8 @@ struct grid_geometry {
 
     /// Lays a grid over `box` with cells at least `reach` (m) wide, or exactly `requested` wide
     /// per axis when it is positive (rounded down to fit the box). The axis with the most cells
-    /// (the first of equals) is numbered slowest; of the other two, a wall axis is numbered
+    /// (the first of equals) is numbered slowest, and without a requested width its count is
+    /// rounded down to a multiple of 4 from 16 cells on (even shares of the slab schedule); of the other two, a wall axis is numbered
     /// fastest when the other is periodic (a run of cells along it never wraps), else the
     /// lower one. Throws when a requested cell is narrower than `reach`, when a periodic axis
     /// has fewer than 3 cells, or when the grid would exceed 2^28 cells.
@@ -88,6 +89,13 @@ struct grid_geometry {
         g.slow = 0;
         for (int a = 1; a < 3; ++a)
             if (g.n[a] > g.n[g.slow]) g.slow = a;
+        if (requested <= 0 && g.n[g.slow] >= 16) {
+            // Layers in a multiple of 4: each of the slab schedule's two phases then holds an
+            // even number of equal tasks, which two threads (or four, with a multiple of 8)
+            // share evenly (contact/interact.cuh); the cells grow by at most 1/5.
+            g.n[g.slow] -= g.n[g.slow] % 4;
+            g.width[g.slow] = box.length(g.slow) / Real(g.n[g.slow]);
+        }
         const int other[2] = {g.slow == 0 ? 1 : 0, g.slow == 2 ? 1 : 2};
         const bool swap = box.periodic(other[0]) && !box.periodic(other[1]);
         g.fast = swap ? other[1] : other[0];
