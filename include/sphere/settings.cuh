@@ -56,7 +56,7 @@ struct settings {
     /// How pair forces reach the particles (contact/summation.cuh): the default picks the
     /// backend's fast schedule; both give the same physics to round-off.
     sphere::pair_summation pair_summation = sphere::pair_summation::automatic;
-    Real cell_size = 0;             ///< neighbour-grid cell width (m); 0 selects the largest diameter plus skin
+    Real cell_size = 0;             ///< neighbour-grid cell width (m); 0 selects at least the largest diameter plus skin (grid/geometry.cuh)
     /// Motion of each wall face f (axis f / 2, lower face when f is even; the upper wall is
     /// walls[5]); all fixed by default.
     wall_control<Real> walls[wall_set<Real>::count];

@@ -64,9 +64,9 @@ struct grid_geometry {
     /// Lays a grid over `box` with cells at least `reach` (m) wide, or exactly `requested` wide
     /// per axis when it is positive (rounded down to fit the box). The axis with the most cells
     /// (the first of equals) is numbered slowest, and without a requested width its count is
-    /// rounded down to a multiple of 4 from 16 cells on (even shares of the slab schedule); of the other two, a wall axis is numbered
-    /// fastest when the other is periodic (a run of cells along it never wraps), else the
-    /// lower one. Throws when a requested cell is narrower than `reach`, when a periodic axis
+    /// rounded down to a multiple of 4 from 16 cells on (even shares of the slab schedule); of
+    /// the other two, a wall axis is numbered fastest when the other is periodic (a run of
+    /// cells along it never wraps), else the lower one. Throws when a requested cell is narrower than `reach`, when a periodic axis
     /// has fewer than 3 cells, or when the grid would exceed 2^28 cells.
     static grid_geometry make(const world<Real>& box, Real reach, Real requested)
     {
