@@ -52,7 +52,9 @@ struct zero_pair_sums {
 /// (contact/history.cuh).
 template <class Real, unsigned Lanes>
 struct pair_tile {
-    static constexpr int width = 16;
+    /// 16 doubles or 32 floats: two AVX-512 vectors (16 floats were 7% slower in mixed on the
+    /// dense bed, docs/performance.md)
+    static constexpr int width = 128 / sizeof(Real);
     int count = 0;
     unsigned owner[width], partner[width], entry[width];
     Real dx[width], dy[width], dz[width], r_i[width], r_j[width], excess[width]; ///< pair_separation
