@@ -672,9 +672,13 @@ TEMPLATE_TEST_CASE("the grid numbers the axis with the most cells slowest", "[gr
         const auto exact = sphere::grid_geometry<Real>::make(box, Real(0.0026), Real(0.0026));
         CHECK(exact.n[0] == 21);
         CHECK(exact.layers() == 21);
-        // fewer than 16 cells are not rounded: a wider world of 15 cells keeps them
+        // fewer than 16 cells are not rounded: a world of 15 x 10 cells keeps 15 along its
+        // slow axis (rounded to a multiple of 4, it would hold 12)
         box.hi.x = Real(0.0026 * 15.5);
-        CHECK(sphere::grid_geometry<Real>::make(box, Real(0.0026), Real(0)).n[0] == 15);
+        box.hi.y = Real(0.0026 * 10.5);
+        const auto small = sphere::grid_geometry<Real>::make(box, Real(0.0026), Real(0));
+        CHECK(small.slow == 0);
+        CHECK(small.n[0] == 15);
     }
     SECTION("a tall closed column: z slowest")
     {
