@@ -82,12 +82,10 @@ struct particle_energy {
         for (unsigned k = c.offset[r]; k < c.offset[r + 1]; ++k) {
             const unsigned j = c.partner[k];
             if (j < wall_partner_base) {
-                const vec4<Coord> xj = p.x[j];
-                const vec3<Coord> d = box.nearest_image_inside(xi.xyz() - xj.xyz());
-                const Coord dist2 = norm2(d), reach = xi.w + xj.w;
-                if (!law_acts<Law>(pair_params, dist2, reach)) continue;
+                pair_separation<Real> s;
+                if (!separate<Law>(pair_params, box, xi, p.x[j], s)) continue;
                 contact_geometry<Real> g;
-                pair_geometry<materials>(g, p, i, j, separation_of<Real>(d, dist2, xi.w, xj.w));
+                pair_geometry<materials>(g, p, i, j, s);
                 law_history_t<Law, Real> h;
                 c.history.load(k, h);
                 e.elastic += Coord(Law::pair_energy(pair_params, g, h));

@@ -91,6 +91,19 @@ SPHERE_HDI bool law_acts(const KernelParams& params, Coord dist2, Coord reach)
     return dist2 < cut * cut && dist2 > Coord(0);
 }
 
+/// The separation s of particles at xi and xj (centre in xyz, radius in w; type Coord) in the
+/// world box, the nearest image, and whether Law with kernel parameters `params` acts on them
+/// (law_acts). s is filled either way, so that callers can sort pairs without a branch.
+template <class Law, class Real, class KernelParams, class Coord>
+SPHERE_HDI bool separate(const KernelParams& params, const world<Coord>& box, const vec4<Coord>& xi,
+                         const vec4<Coord>& xj, pair_separation<Real>& s)
+{
+    const vec3<Coord> d = box.nearest_image_inside(xi.xyz() - xj.xyz());
+    const Coord dist2 = norm2(d);
+    s = separation_of<Real>(d, dist2, xi.w, xj.w);
+    return law_acts<Law>(params, dist2, xi.w + xj.w);
+}
+
 /// Fills the geometry g of the contact of particles i and j of p, as seen by i, from their
 /// separation s; with `Materials` (a law that tells materials apart, contact/law.cuh) their
 /// material indices too, else 0.
@@ -151,30 +164,28 @@ struct pair_contact {
     using history_type = law_history_t<Law, Real>;
     static constexpr bool materials = law_material_count<Law>::value > 1;
 
-    /// Whether the law acts on a pair at squared distance dist2 (m^2) whose radii sum to reach
-    /// (m): distinct centres that overlap, or for a law that acts apart (contact/law.cuh) lie
+    /// The separation s of particles at xi and xj (p.x) and whether the law acts on them:
+    /// distinct centres that overlap, or for a law that acts apart (contact/law.cuh) lie
     /// within its range of touching.
-    SPHERE_HDI bool acts(Coord dist2, Coord reach) const
+    SPHERE_HDI bool separate(const vec4<Coord>& xi, const vec4<Coord>& xj, pair_separation<Real>& s) const
     {
-        return law_acts<Law>(params, dist2, reach);
+        return sphere::detail::separate<Law>(params, box, xi, xj, s);
     }
 
     /// The contact of i (owner) and j (slots) with history h (updated): both particles'
-    /// share, or zero when the law does not act on them (acts()), which also resets the
+    /// share, or zero when the law does not act on them (separate()), which also resets the
     /// history.
     SPHERE_HDI pair_result<Real> evaluate(std::size_t i, std::size_t j, history_type& h) const
     {
-        const vec4<Coord> xi = p.x[i], xj = p.x[j];
-        vec3<Coord> d = box.nearest_image_inside(xi.xyz() - xj.xyz());
-        const Coord dist2 = norm2(d);
-        if (!acts(dist2, xi.w + xj.w)) {
+        pair_separation<Real> s;
+        if (!separate(p.x[i], p.x[j], s)) {
             h = history_type{}; // a contact that has ended forgets its history
             return {};
         }
-        return evaluate_touching(i, j, separation_of<Real>(d, dist2, xi.w, xj.w), h);
+        return evaluate_touching(i, j, s, h);
     }
 
-    /// The contact of i (owner) and j with separation s, on which the law acts (acts()), with
+    /// The contact of i (owner) and j with separation s, on which the law acts (separate()), with
     /// history h (updated): both particles' share. For callers that have the separation already
     /// (the SIMD tiles of contact/interact.cuh).
     SPHERE_HDI pair_result<Real> evaluate_touching(std::size_t i, std::size_t j, const pair_separation<Real>& s,

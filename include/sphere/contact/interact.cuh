@@ -94,19 +94,16 @@ struct slab_pairs {
                 // the sliding flag goes into the tile here: the SIMD loop gathers the
                 // displacements, but cannot gather bytes
                 t.hw[t.count] = Real(c.history.flags[e]);
-                const vec4<Coord> xj = p.x[j];
-                vec3<Coord> d = eval.box.nearest_image_inside(xi.xyz() - xj.xyz());
-                const Coord dist2 = norm2(d);
-                const pair_separation<Real> s = separation_of<Real>(d, dist2, xi.w, xj.w);
+                pair_separation<Real> s;
+                const bool touching = eval.separate(xi, p.x[j], s);
                 t.dx[t.count] = s.d.x;
                 t.dy[t.count] = s.d.y;
                 t.dz[t.count] = s.d.z;
                 t.r_i[t.count] = s.r_i;
                 t.r_j[t.count] = s.r_j;
-                t.excess[t.count] = s.excess;
+                if constexpr (wide) t.excess[t.count] = s.excess;
                 // Only touching pairs take a lane; the others only forget their history. Both
                 // lists grow without a branch on the outcome, which no predictor could guess.
-                const bool touching = eval.acts(dist2, xi.w + xj.w);
                 apart[apart_count] = e;
                 t.count += touching;
                 apart_count += !touching;
@@ -120,6 +117,8 @@ struct slab_pairs {
 
 private:
     using Coord = coord_t<P>;
+    /// positions wider than the law's type (mixed): the tile carries the overlap's excess
+    static constexpr bool wide = !std::is_same_v<Real, Coord>;
     using history_type = law_history_t<Law, Real>;
     static constexpr unsigned lanes = law_history_shape<Law>::value.lanes;
     using tile = pair_tile<Real, lanes>;
@@ -147,7 +146,7 @@ private:
             t.dz[k] = t.dz[0];
             t.r_i[k] = t.r_i[0];
             t.r_j[k] = t.r_j[0];
-            t.excess[k] = t.excess[0];
+            if constexpr (wide) t.excess[k] = t.excess[0];
         }
         // Local copies: loop invariants the compiler can keep in registers.
         pair_contact<P, Law, OneVelocity> pairs = eval;
@@ -164,7 +163,7 @@ private:
             sep.d = {t.dx[k], t.dy[k], t.dz[k]};
             sep.r_i = t.r_i[k];
             sep.r_j = t.r_j[k];
-            sep.excess = t.excess[k];
+            sep.excess = wide ? t.excess[k] : Real(0);
             pair_result<Real> r = pairs.evaluate_touching(t.owner[k], t.partner[k], sep, h);
             t.fx[k] = r.force.x;
             t.fy[k] = r.force.y;
