@@ -46,7 +46,8 @@ work=$(mktemp -d); trap 'rm -rf "$work"' EXIT
 logs=${SPHERE_GPU_LOGS:-$work}
 mkdir -p "$logs"
 tests=passed
-timeout "$limit_tests" "$bin/tests/sphere_cuda_tests" --durations yes 2>&1 | tee "$logs/tests.log" || tests=FAILED
+timeout "$limit_tests" "$bin/tests/sphere_cuda_tests" --durations yes 2>&1 | tee "$logs/tests.log" \
+    || { [[ ${PIPESTATUS[0]} == 124 ]] && tests="FAILED: stopped at its ${limit_tests} s limit" || tests=FAILED; }
 grep -q "no CUDA device" "$logs/tests.log" && fail "the CUDA runtime finds no device although nvidia-smi lists $gpu"
 
 # The program on the GPU: its input is the consolidation example's checkpoint, as in CTest.
@@ -107,5 +108,5 @@ nvcc_version=$(nvcc --version 2>/dev/null | tail -n 1) || nvcc_version="no nvcc 
     sed 's/^/    /' "$logs/bed.log"
 } > "$out"
 echo "gpu-check: wrote $out"
-[[ $tests == passed ]] || fail "sphere_cuda_tests failed (above)"
+[[ $tests == passed ]] || fail "sphere_cuda_tests: $tests (above)"
 [[ $program == passed ]] || fail "tests/test_program.py failed on sphere-cuda (above)"
