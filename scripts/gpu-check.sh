@@ -96,9 +96,9 @@ for tile in "2 1" "4 5" "8 10"; do
     done
 done
 
-# Nsight Compute on the step's passes at 1e6 particles: two steps' launches after two untimed
-# steps' (4 passes per step on the gather schedule), each pass's time, memory throughput,
-# registers and occupancy (scripts/ncu_table.py).
+# Nsight Compute on the step's passes at 1e6 particles (the gather schedule's evaluate and
+# gather, the drift, the integration with its check): eight launches after the first eight,
+# each pass's time, memory throughput, registers and occupancy (scripts/ncu_table.py).
 ncu_bin=$(command -v ncu || true)
 [[ -z $ncu_bin && -x $(dirname "$(command -v nvcc || echo .)")/ncu ]] && ncu_bin=$(dirname "$(command -v nvcc)")/ncu
 profile=""

@@ -14,7 +14,8 @@ import re
 import sys
 
 WRAPPERS = {"for_each_index_kernel", "store_values", "then_check", "unless_halted", "by_rank", "both"}
-KERNEL = re.compile(r"^\s{2}void (\S.*?)\(unsigned long, T1\)")
+# a kernel's heading: its name and parameters, grid x block, context, stream, device
+KERNEL = re.compile(r"^\s{2}(\S.*?) \(\d+, \d+, \d+\)x\(\d+, \d+, \d+\), Context \d+")
 METRIC = re.compile(r"^\s{4}(\S.*?\S)\s{2,}(\S+)\s+([\d.,]+)\s*$")
 UNIT_MS = {"ns": 1e-6, "us": 1e-3, "usecond": 1e-3, "ms": 1.0, "msecond": 1.0, "s": 1e3, "second": 1e3}
 UNIT_TBS = {"Gbyte/s": 1e-3, "Tbyte/s": 1.0, "Mbyte/s": 1e-6}
