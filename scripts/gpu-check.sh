@@ -99,8 +99,7 @@ done
 # Nsight Compute on the step's passes at 1e6 particles (the gather schedule's evaluate and
 # gather, the drift, the integration with its check): eight launches after the first eight,
 # each pass's time, memory throughput, registers and occupancy (scripts/ncu_table.py).
-ncu_bin=$(command -v ncu || true)
-[[ -z $ncu_bin && -x $(dirname "$(command -v nvcc || echo .)")/ncu ]] && ncu_bin=$(dirname "$(command -v nvcc)")/ncu
+ncu_bin=$(command -v ncu || command -v /usr/local/cuda/bin/ncu || true) # the toolkit's place, if not on PATH
 profile=""
 if [[ ${SPHERE_GPU_PROFILE:-1} == 0 ]]; then
     profile="not run (SPHERE_GPU_PROFILE=0)"
