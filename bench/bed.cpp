@@ -176,7 +176,7 @@ int run(const options& o, const bed_file& b)
     // the simulation's own memory: measured before the counts make host copies
     const double rss_sim = status_bytes("VmRSS"), peak_sim = status_bytes("VmHWM");
     const counts c0 = count(sim);
-    const std::size_t rebuilds0 = sim.rebuilds();
+    const std::size_t rebuilds0 = sim.rebuilds(), near0 = sim.near_walks();
     const auto t0 = std::chrono::steady_clock::now();
     sim.run(o.steps);
     const auto t1 = std::chrono::steady_clock::now();
@@ -184,10 +184,10 @@ int run(const options& o, const bed_file& b)
     const double seconds = std::chrono::duration<double>(t1 - t0).count();
     const std::string where = on_host ? "threads=" + std::to_string(o.threads) : "backend=cuda";
     std::printf("sphere   N=%zu %s precision=%s order=%s loop=%.3f s  %.3e particle-steps/s  contacts "
-                "%.4f -> %.4f  wall %zu -> %zu  KE/(N m g d) %.2e -> %.2e  rebuilds %zu\n",
+                "%.4f -> %.4f  wall %zu -> %zu  KE/(N m g d) %.2e -> %.2e  rebuilds %zu  near walks %zu\n",
                 n, where.c_str(), o.precision.c_str(), o.order.c_str(), seconds, double(n) * double(o.steps) / seconds,
                 c0.pair_contacts_per_particle, c1.pair_contacts_per_particle, c0.wall_contacts, c1.wall_contacts,
-                c0.kinetic, c1.kinetic, sim.rebuilds() - rebuilds0);
+                c0.kinetic, c1.kinetic, sim.rebuilds() - rebuilds0, sim.near_walks() - near0);
     if (on_host) // the CUDA backend's particles are not in the resident set
         std::printf("memory   N=%zu precision=%s  RSS of the program and input %.0f MB; after %zu steps %.0f MB: "
                     "simulation +%.0f B/particle; peak %.0f B/particle for the whole process (set-up, particle "

@@ -66,7 +66,7 @@ void grid_rebuild(benchmark::State& state)
     for (auto _ : state) {
         do {
             grid.build(context, view);
-            lists.rebuild(context, grid.view(), walls, Real(0), true, totals.data());
+            lists.rebuild(context, grid.view(), walls, Real(0), Real(0), true, totals.data());
         } while (!lists.settle(totals.data()[0])); // the first grows the lists
         benchmark::DoNotOptimize(lists.entries());
     }

@@ -477,6 +477,10 @@ public:
     std::size_t steps() const { return steps_; }
     /// How many times the grid and contact lists were built (including at setup).
     std::size_t rebuilds() const { return rebuilds_; }
+    /// How many of this simulation object's steps summed the pair contacts walking only each
+    /// row's near partners (the host's slab schedule, while no particle has moved half the near
+    /// skin since the last rebuild: docs/architecture.md, *Near partners*). Not in the state.
+    std::size_t near_walks() const { return near_walks_; }
     /// The deepest overlap the particles started with, as a fraction of the smaller radius (of
     /// the particle's at a wall); settings.max_initial_overlap bounds it.
     double initial_overlap() const { return initial_overlap_; }
@@ -709,7 +713,9 @@ public:
         particles_.restore(restored);
         largest_radius_ = 0;
         for (const vec4<Coord>& x : restored.x) largest_radius_ = x.w > largest_radius_ ? x.w : largest_radius_;
-        lists_.restore(s.contacts, g, !settings_.reorder);
+        lists_.restore(s.contacts, g, near_skin() + range_, !settings_.reorder);
+        far_clear_ = false; // the table's other partners may have histories
+        moved_ = std::numeric_limits<double>::infinity(); // until the next particle check
         interaction_.lists_changed();
         wall_launch_ = lists_.wall_particles();
         detail::step_report<Coord> fresh{};
@@ -820,7 +826,7 @@ private:
         // positions at the rebuild of each slot.
         grid_.build(context_, particles_.view(), x_at_build_.data());
         const grid_view<Coord> g = grid_.view();
-        lists_.rebuild(context_, g, walls_, settings_.skin + range_, !settings_.reorder, totals);
+        lists_.rebuild(context_, g, walls_, settings_.skin + range_, near_skin() + range_, !settings_.reorder, totals);
         interaction_.lists_changed();
         if (settings_.reorder) {
             particles_.permute(g.order, x_at_build_.data(), external_);
@@ -843,6 +849,8 @@ private:
         }
         wall_launch_ = t.wall_particles;
         walls_at_build_ = walls_;
+        moved_ = 0;
+        far_clear_ = true;
         ++rebuilds_;
         needs_rebuild_ = false;
         return true;
@@ -897,6 +905,11 @@ private:
         // nothing that lasts changes (the bodies see *halt), the capacities grow and it runs
         // again, to the same bits as with room from the start.
         const bool rebuild = needs_rebuild_;
+        // Whether the lists' other partners are apart now, and whether the pair sums may then
+        // walk the near ones alone (their histories are clear: docs/architecture.md).
+        const bool apart = rebuild || near_holds();
+        near_only_ = apart && (rebuild || far_clear_);
+        if (near_only_ && summation_ == pair_summation::slabs) ++near_walks_;
         detail::step_report<Coord> done{};
         do {
             if (rebuild) rebuild_lists(&report->lists);
@@ -926,6 +939,7 @@ private:
             context_.read_back(&done, report, 1,
                                "the step's report (wall loads, particle check, drive power, list totals)", steps_ + 1);
         } while (rebuild && !settle_rebuild(done.lists));
+        far_clear_ = apart; // the walk has cleared their histories, or found them touching
         advance_walls(walls_, settings_.walls, settings_.box, done.loads.force, time_, dt_, steps_ + 1);
         if (drive_) drive_work_ += done.drive_power * double(dt_);
         ++steps_;
@@ -958,7 +972,8 @@ private:
             std::vector<Coord> moved(std::size_t(host_threads()), Coord(0));
             const detail::finish_block<Precision, decltype(walls), Body, Check> finish{
                 walls, body, checks, lists_.view(), lists_.wall_ranks(), count, wall_loads_.data(), moved.data(), halt};
-            if (interaction_.template sum_pairs<Book, Record>(context_, pair_contact(), lists_, summation_, true, finish)) {
+            if (interaction_.template sum_pairs<Book, Record>(context_, pair_contact(), lists_, summation_, true,
+                                                              near_only_, finish)) {
                 report->loads = detail::wall_loads{{0, 0, 0, 0, 0, 0}};
                 for (const detail::wall_loads& l : wall_loads_) report->loads = report->loads + l;
                 report->moved2 = 0;
@@ -1043,11 +1058,32 @@ private:
                                                  ~std::size_t(0), min_op{}),
                                 step);
         const double moved = std::sqrt(double(moved2)) + margin, skin = double(settings_.skin);
+        moved_ = moved;
         bool rebuild = 2 * moved > skin;
         for (int f = 0; f < wall_set<Coord>::count; ++f)
             if (walls_.face[f].active && std::fabs(walls_.face[f].position - walls_at_build_.face[f].position) + moved > skin)
                 rebuild = true;
         needs_rebuild_ = needs_rebuild_ || rebuild;
+    }
+
+    /// The near skin (m): the lists put first in each row the partners within r_i + r_j + near
+    /// skin (+ the law's range) at the rebuild, an eighth of the skin (docs/architecture.md,
+    /// *Near partners*).
+    Coord near_skin() const { return settings_.skin / 8; }
+
+    /// Whether the other partners of the lists are still apart: no particle has moved a half
+    /// near skin since the rebuild (moved_, from the last particle check), less a margin for the
+    /// rounding of the positions and distances the tests compare (16 units of Coord's last
+    /// place of the largest coordinate, diameter and skin).
+    bool near_holds() const
+    {
+        double extent = 2 * double(largest_radius_) + double(settings_.skin);
+        for (int a = 0; a < 3; ++a)
+            extent += std::max(std::fabs(double(settings_.box.lo[a])), std::fabs(double(settings_.box.hi[a])));
+        for (const wall_face<Coord>& w : walls_.face)
+            if (w.active) extent = std::max(extent, std::fabs(w.position));
+        const double margin = 16 * double(std::numeric_limits<Coord>::epsilon()) * extent;
+        return 2 * moved_ + margin < double(near_skin());
     }
 
     /// Refuses a value that the particle fields and contact laws cannot hold in Real when Real
@@ -1295,12 +1331,16 @@ private:
     buffer<vec3<Real>, Policy> external_; ///< external forces (empty until external_forces() is called)
     double initial_overlap_ = 0;          ///< initial_overlap()
     std::vector<detail::wall_loads> wall_loads_; ///< each wall particle's loads of the step (host)
-    std::size_t wall_launch_ = 0;
+    std::size_t wall_launch_ = 0; ///< wall contact threads: the wall particles, or all after a rebuild not yet read back
     /// Velocity Verlet: the last step's report holds the check of the positions the next drift
     /// gives (false at the start and after the host changed what the drift reads), and the
     /// margin (m) that covers the rounding between the two (16 ulp of the largest coordinate).
     bool drift_checked_ = false;
-    double drift_margin_ = 0; ///< wall contact threads: the wall particles, or all after a rebuild not yet read back
+    double drift_margin_ = 0;
+    double moved_ = 0;           ///< the largest displacement since the last rebuild (m), by the last particle check
+    bool far_clear_ = true;      ///< the lists' other partners (not near) have no history
+    bool near_only_ = false;     ///< this step's pair sums walk the near partners alone
+    std::size_t near_walks_ = 0; ///< near_walks()
     std::vector<motion> kinds_; ///< host copy of each particle's motion (it never changes)
     std::vector<std::pair<std::size_t, observer>> observers_;
     thread_governor governor_; ///< all threads or one, whichever is faster on this machine now

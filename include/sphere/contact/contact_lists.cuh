@@ -7,10 +7,14 @@
 /// after layer along its slow axis (grid/geometry.cuh), so each layer is a range of ranks. A
 /// pair {a, b} with |x_a - x_b| < r_a + r_b + skin is owned by one of the two: the one whose
 /// layer comes first (b in the next layer, cyclically on a periodic axis), or, in the same
-/// layer, the one of lower rank. The row of rank r lists the partners it owns, by partner rank,
-/// then every wall face within r + skin (by face). Each entry holds the contact's history
-/// (tangential displacement as seen by the owner, sliding flag) and, when recorded, the force
-/// of the last step. The lists hold what they find: no capacity to set.
+/// layer, the one of lower rank. The row of rank r lists the partners it owns: first those
+/// within r_a + r_b + near skin at the rebuild (its *near* partners), then the others, each
+/// group by partner rank, then every wall face within r + skin (by face). While no particle
+/// has moved more than half the near skin since the rebuild, the others cannot touch, and the
+/// host's pair sums walk the near partners alone (docs/architecture.md, *Near partners*).
+/// Each entry holds the contact's history (tangential displacement as seen by the owner,
+/// sliding flag) and, when recorded, the force of the last step. The lists hold what they
+/// find: no capacity to set.
 ///
 /// Ranks and ownership depend on the positions at the rebuild and the user indices alone, so
 /// the interaction, which follows them (contact/interact.cuh), gives the same bits whether or
@@ -70,6 +74,7 @@ struct contact_view {
     vec4<Real>* force;            ///< f_t on the owner (N) in xyz, f_n . n (N) in w; null when not recorded
     const unsigned* slot_of_rank; ///< storage slot of each rank; null when they coincide (settings.reorder)
     const unsigned* rank_of_slot; ///< the inverse; null when they coincide
+    const unsigned* near_end;     ///< rank r's near partners: [offset[r], near_end[r])
 
     SPHERE_HDI std::size_t slot(std::size_t r) const { return slot_of_rank ? slot_of_rank[r] : r; }
     SPHERE_HDI std::size_t rank(std::size_t s) const { return rank_of_slot ? rank_of_slot[s] : s; }
@@ -240,13 +245,26 @@ struct old_lists {
     }
 };
 
+/// Whether particles at xi and xj (centre in xyz, radius in w) lie within r_i + r_j + near_skin
+/// of each other: near partners (fill_entries, contact_lists::restore).
+template <class Real>
+SPHERE_HDI bool near_partners(const world<Real>& box, const vec4<Real>& xi, const vec4<Real>& xj, Real near_skin)
+{
+    const Real reach = xi.w + xj.w + near_skin;
+    return norm2(box.nearest_image(xi.xyz() - xj.xyz())) < reach * reach;
+}
+
 /// Fills the new row of rank k: partners by rank (stored as slots: the rank itself once the
-/// particles are permuted into rank order, the grid's old slot with `keep_order`), walls last,
-/// and carries over the history each contact had in the old lists.
+/// particles are permuted into rank order, the grid's old slot with `keep_order`), the near
+/// partners first, walls last, and carries over the history each near contact had in the old
+/// lists. The other partners start without one: they do not touch now, so the next pair sums
+/// would clear it.
 template <class Coord, class Real>
 struct fill_entries {
     neighbour_scan<Coord> scan;
+    Coord near_skin;
     const unsigned* offset;
+    unsigned* near_end;
     unsigned* partner;
     history_view<Real> history;
     old_lists<Real> old;
@@ -268,6 +286,15 @@ struct fill_entries {
             for (; b > 0 && p[b - 1] > q; --b) p[b] = p[b - 1];
             p[b] = q;
         }
+        const vec4<Coord> xi = scan.grid.sorted_x[k];
+        unsigned near = 0;
+        for (unsigned a = 0; a < pairs; ++a) { // near partners to the front, both groups in order
+            const unsigned q = p[a];
+            if (!near_partners(scan.grid.geometry.box, xi, scan.grid.sorted_x[q], near_skin)) continue;
+            for (unsigned b = a; b > near; --b) p[b] = p[b - 1];
+            p[near++] = q;
+        }
+        near_end[k] = begin + near;
         const unsigned* order = scan.grid.order; // old slot of each rank
         const unsigned me = order[k];
         for (unsigned a = 0; a < n; ++a) {
@@ -278,8 +305,10 @@ struct fill_entries {
                 found = old.find(me, code, m);
             } else {
                 const unsigned them = order[code];
-                found = old.find(me, them, m);
-                if (!found) found = mirror = old.find(them, me, m);
+                if (a < near) {
+                    found = old.find(me, them, m);
+                    if (!found) found = mirror = old.find(them, me, m);
+                }
                 p[a] = keep_order ? them : code;
             }
             if (found) history.copy(begin + a, old.history, m, mirror);
@@ -382,10 +411,14 @@ struct record_wall_particles {
 /// Empties every row of lists that overflowed, so that nothing reads past their arrays.
 struct empty_if_overflow {
     unsigned* offset;
+    unsigned* near_end;
+    std::size_t n;
     const list_totals* totals;
     SPHERE_HD void operator()(std::size_t r) const
     {
-        if (totals->overflow) offset[r] = 0;
+        if (!totals->overflow) return;
+        offset[r] = 0;
+        if (r < n) near_end[r] = 0;
     }
 };
 
@@ -416,7 +449,7 @@ public:
     /// Empty lists for n particles whose histories have `shape` (the contact law's,
     /// contact/history.cuh); `record_forces` keeps each entry's force of the last step.
     contact_lists(std::size_t n, bool record_forces, history_shape shape = {})
-        : record_forces_(record_forces), offset_(n + 1, 0u), next_offset_(n + 1, 0u), history_(shape),
+        : record_forces_(record_forces), offset_(n + 1, 0u), next_offset_(n + 1, 0u), near_end_(n, 0u), history_(shape),
           kept_offset_(n + 1, 0u), kept_history_(shape), wall_ranks_(n, no_rank)
     {
     }
@@ -447,11 +480,12 @@ public:
     /// caller to read back and hand to settle(). The new lists are in the grid's order (its
     /// ranks); partners are stored as ranks, to be the slots once the caller permutes the
     /// particles into that order, or, with `keep_order`, as the current slots, which the
-    /// particles keep. Walls within r + skin are listed too. When the histories to carry over
-    /// or the new entries exceed the capacities, the new lists are empty and the old ones (or
+    /// particles keep. Walls within r + skin are listed too; the partners within r_a + r_b +
+    /// near_skin (at most skin) come first in each row. When the histories to carry over or
+    /// the new entries exceed the capacities, the new lists are empty and the old ones (or
     /// their histories) stay for the rebuild to run again after settle().
     void rebuild(execution_context<Policy>& ctx, const grid_view<Coord>& grid, const wall_set<Coord>& walls, Coord skin,
-                 bool keep_order, list_totals* totals)
+                 Coord near_skin, bool keep_order, list_totals* totals)
     {
         const std::size_t n = size();
         if (!histories_kept_) keep_histories(ctx);
@@ -467,11 +501,11 @@ public:
                        detail::record_totals{kept_offset_.data(), offset, n, kept_capacity(), capacity(), totals});
         const detail::old_lists<Real> old{kept_offset_.data(), kept_partner_.data(), kept_history_.view()};
         for_each_index(Policy{}, n,
-                       detail::fill_entries<Coord, Real>{scan, offset, partner_.data(), history_.view(), old, keep_order,
-                                                         totals});
+                       detail::fill_entries<Coord, Real>{scan, near_skin, offset, near_end_.data(), partner_.data(),
+                                                         history_.view(), old, keep_order, totals});
         if (record_forces_) for_each_index(Policy{}, capacity(), detail::fill_value<vec4<Real>>{force_.data(), {0, 0, 0, 0}});
         set_wall_ranks(ctx, offset, totals);
-        for_each_index(Policy{}, n + 1, detail::empty_if_overflow{offset, totals});
+        for_each_index(Policy{}, n + 1, detail::empty_if_overflow{offset, near_end_.data(), n, totals});
         if (keep_order) {
             if (slot_of_rank_.size() != n) {
                 slot_of_rank_.resize(n);
@@ -534,7 +568,8 @@ public:
                 history_.view(),
                 record_forces_ ? force_.data() : nullptr,
                 keep_order_ ? slot_of_rank_.data() : nullptr,
-                keep_order_ ? rank_of_slot_.data() : nullptr};
+                keep_order_ ? rank_of_slot_.data() : nullptr,
+                near_end_.data()};
     }
 
     /// A host copy in user order, each pair from both sides; `user` is the user index of each
@@ -598,9 +633,10 @@ public:
     /// Replaces the lists by a table in user order (for restarts): `grid` is built over the
     /// positions of the last rebuild in user order (its `order` holds the user index of each
     /// rank), and the particles are stored in rank order unless `keep_order` (then in user
-    /// order). Each pair takes the history its owner's entry has in the table. Throws when the
-    /// table does not fit or is not symmetric.
-    void restore(const contact_table<Coord>& t, const grid_view<Coord>& grid, bool keep_order)
+    /// order). Each pair takes the history its owner's entry has in the table; rows list the
+    /// partners within r_a + r_b + near_skin of those positions first, as rebuild() does.
+    /// Throws when the table does not fit or is not symmetric.
+    void restore(const contact_table<Coord>& t, const grid_view<Coord>& grid, Coord near_skin, bool keep_order)
     {
         const std::size_t n = size();
         const history_shape shape = history_.shape();
@@ -621,7 +657,7 @@ public:
             if (la == lb) return a < b;
             return lb == la + 1 || (g.box.periodic(g.slow) && layers >= 3 && la == layers - 1 && lb == 0);
         };
-        std::vector<unsigned> off(n + 1, 0), part;
+        std::vector<unsigned> off(n + 1, 0), part, near_end(n);
         std::vector<vec4<Real>> hist;
         std::vector<Real> lanes;
         // the table's entry e as the lists store it: its base, then its lanes
@@ -650,6 +686,10 @@ public:
                 if (owns(unsigned(r), q)) row.emplace_back(q, e);
             }
             std::sort(row.begin(), row.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+            const auto far = std::stable_partition(row.begin(), row.end(), [&](const auto& a) {
+                return detail::near_partners(g.box, x[r], x[a.first], near_skin);
+            });
+            near_end[r] = static_cast<unsigned>(part.size() + std::size_t(far - row.begin()));
             std::sort(walls.begin(), walls.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
             for (const auto& [q, e] : row) {
                 part.push_back(keep_order ? user_of_rank[q] : q);
@@ -666,6 +706,7 @@ public:
         for (std::size_t r = 0; r < n; ++r)
             if (off[r + 1] > off[r] && part[off[r + 1] - 1] >= wall_partner_base) wall_ranks[with_walls++] = unsigned(r);
         offset_.assign(off);
+        near_end_.assign(near_end);
         partner_.assign(part);
         history_.assign(hist, lanes);
         wall_ranks_.assign(wall_ranks);
@@ -744,6 +785,7 @@ private:
     std::size_t entries_ = 0, overflows_ = 0;
     buffer<unsigned, Policy> offset_;      ///< row r: entries [offset_[r], offset_[r + 1])
     buffer<unsigned, Policy> next_offset_; ///< the rows a rebuild counts (then swapped with offset_)
+    buffer<unsigned, Policy> near_end_;    ///< row r's near partners: [offset_[r], near_end_[r])
     buffer<unsigned, Policy> partner_;     ///< capacity() entries
     history_store<Real, Policy> history_;
     buffer<vec4<Real>, Policy> force_;

@@ -68,13 +68,16 @@ struct pair_tile {
 
 /// The pair sums of the host's slab schedule, for the owners of a range of ranks: pairs are
 /// gathered into tiles in row order, evaluated lane-parallel, then added to both particles in
-/// tile order (so each particle's sum has a fixed order).
+/// tile order (so each particle's sum has a fixed order). `near_only`: walk each row's near
+/// partners alone (contact/contact_lists.cuh; the caller knows that the others are apart and
+/// without history, so the sums and histories are the same bits either way).
 template <class P, class Law, bool Book, bool Record, bool OneVelocity>
 struct slab_pairs {
     using Real = real_t<P>;
     pair_contact<P, Law, OneVelocity> eval;
     contact_view<Real> c;
     bool update_history;
+    bool near_only;
 
     void operator()(unsigned first_rank, unsigned end_rank) const
     {
@@ -83,7 +86,7 @@ struct slab_pairs {
         int apart_count = 0;
         const particle_view<P>& p = eval.p;
         for (unsigned r = first_rank; r < end_rank; ++r) {
-            const unsigned i = static_cast<unsigned>(c.slot(r)), end = c.offset[r + 1];
+            const unsigned i = static_cast<unsigned>(c.slot(r)), end = near_only ? c.near_end[r] : c.offset[r + 1];
             const vec4<Coord> xi = p.x[i];
             for (unsigned e = c.offset[r]; e < end; ++e) {
                 const unsigned j = c.partner[e];
@@ -470,17 +473,20 @@ public:
     /// dissipation rates) with the sums over its pair contacts. Book implies update_history.
     /// On the slab schedule, each thread then runs `finish(first_rank, end_rank, thread)` on a
     /// block of ranks (all ranks in all), in the same parallel region; returns whether it did,
-    /// so that the caller runs that work otherwise.
+    /// so that the caller runs that work otherwise. `near_only`: the slab schedule walks only
+    /// the near partners of each row, which the caller has found to be the only ones that can
+    /// touch, the others having no history (the gather schedule walks every entry).
     template <bool Book, bool Record, class Law, bool OneVelocity, class Finish = detail::no_finish>
     bool sum_pairs(execution_context<Policy>& ctx, const detail::pair_contact<P, Law, OneVelocity>& eval,
-                   contact_lists<P, Policy>& lists, pair_summation how, bool update_history, const Finish& finish = {})
+                   contact_lists<P, Policy>& lists, pair_summation how, bool update_history, bool near_only = false,
+                   const Finish& finish = {})
     {
         const particle_view<P>& p = eval.p;
         const contact_view<Real> c = lists.view();
         if (resolve(how) == pair_summation::slabs) {
             if constexpr (runs_in_blocks<Policy>) {
                 const detail::slab_phases phases(lists.layer_entries(), lists.periodic_layers());
-                detail::sum_by_slabs(detail::slab_pairs<P, Law, Book, Record, OneVelocity>{eval, c, update_history},
+                detail::sum_by_slabs(detail::slab_pairs<P, Law, Book, Record, OneVelocity>{eval, c, update_history, near_only},
                                      detail::zero_pair_sums<P, Book>{p}, finish, p.n, lists.layer_start(), phases);
             }
             return true;
