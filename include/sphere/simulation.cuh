@@ -908,8 +908,8 @@ private:
         // Whether the lists' other partners are apart now, and whether the pair sums may then
         // walk the near ones alone (their histories are clear: docs/architecture.md).
         const bool apart = rebuild || near_holds();
-        near_only_ = apart && (rebuild || far_clear_);
-        if (near_only_ && summation_ == pair_summation::slabs) ++near_walks_;
+        const bool near_only = apart && (rebuild || far_clear_);
+        if (near_only && summation_ == pair_summation::slabs) ++near_walks_;
         detail::step_report<Coord> done{};
         do {
             if (rebuild) rebuild_lists(&report->lists);
@@ -919,9 +919,9 @@ private:
                 if constexpr (Book) {
                     const detail::both<detail::finish_audit<Precision>, decltype(integrate)> body{{p, Real(dt_)},
                                                                                                    integrate};
-                    finish_step<Book, Record>(body, checks, report);
+                    finish_step<Book, Record>(body, checks, report, near_only);
                 } else {
-                    finish_step<Book, Record>(integrate, checks, report);
+                    finish_step<Book, Record>(integrate, checks, report, near_only);
                 }
             };
             if constexpr (!drifted) finish(check());
@@ -957,12 +957,12 @@ private:
             if (steps_ % o.first == 0) o.second(*this);
     }
 
-    /// The pair sums, the walls, `body` (the integration after the forces) and the particle
-    /// check `checks`: in one parallel region on the host's slab schedule, else pass after
-    /// pass. Leaves the wall loads and the check's largest squared displacement in `report`
+    /// The pair sums (`near_only`: on the slab schedule, the near partners alone), the walls,
+    /// `body` (the integration after the forces) and the particle check `checks`: in one
+    /// parallel region on the host's slab schedule, else pass after pass. Leaves the wall loads and the check's largest squared displacement in `report`
     /// (policy memory).
     template <bool Book, bool Record, class Body, class Check>
-    void finish_step(const Body& body, const Check& checks, detail::step_report<Coord>* report)
+    void finish_step(const Body& body, const Check& checks, detail::step_report<Coord>* report, bool near_only)
     {
         const auto walls = wall_contacts<Book, Record>(true);
         const unsigned* halt = &report->lists.overflow;
@@ -973,7 +973,7 @@ private:
             const detail::finish_block<Precision, decltype(walls), Body, Check> finish{
                 walls, body, checks, lists_.view(), lists_.wall_ranks(), count, wall_loads_.data(), moved.data(), halt};
             if (interaction_.template sum_pairs<Book, Record>(context_, pair_contact(), lists_, summation_, true,
-                                                              near_only_, finish)) {
+                                                              near_only, finish)) {
                 report->loads = detail::wall_loads{{0, 0, 0, 0, 0, 0}};
                 for (const detail::wall_loads& l : wall_loads_) report->loads = report->loads + l;
                 report->moved2 = 0;
@@ -1073,16 +1073,13 @@ private:
 
     /// Whether the other partners of the lists are still apart: no particle has moved a half
     /// near skin since the rebuild (moved_, from the last particle check), less a margin for the
-    /// rounding of the positions and distances the tests compare (16 units of Coord's last
-    /// place of the largest coordinate, diameter and skin).
+    /// rounding of the positions and distances the tests compare: 16 units of Coord's last
+    /// place of the largest coordinate (drift_margin_; the walls stay inside the box) for each
+    /// of the three axes, and of the largest diameter and skin.
     bool near_holds() const
     {
-        double extent = 2 * double(largest_radius_) + double(settings_.skin);
-        for (int a = 0; a < 3; ++a)
-            extent += std::max(std::fabs(double(settings_.box.lo[a])), std::fabs(double(settings_.box.hi[a])));
-        for (const wall_face<Coord>& w : walls_.face)
-            if (w.active) extent = std::max(extent, std::fabs(w.position));
-        const double margin = 16 * double(std::numeric_limits<Coord>::epsilon()) * extent;
+        const double margin = 3 * drift_margin_ + 16 * double(std::numeric_limits<Coord>::epsilon()) *
+                                                      (2 * double(largest_radius_) + double(settings_.skin));
         return 2 * moved_ + margin < double(near_skin());
     }
 
@@ -1339,7 +1336,6 @@ private:
     double drift_margin_ = 0;
     double moved_ = 0;           ///< the largest displacement since the last rebuild (m), by the last particle check
     bool far_clear_ = true;      ///< the lists' other partners (not near) have no history
-    bool near_only_ = false;     ///< this step's pair sums walk the near partners alone
     std::size_t near_walks_ = 0; ///< near_walks()
     std::vector<motion> kinds_; ///< host copy of each particle's motion (it never changes)
     std::vector<std::pair<std::size_t, observer>> observers_;

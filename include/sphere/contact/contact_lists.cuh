@@ -113,6 +113,16 @@ struct contact_table {
 };
 
 namespace detail {
+/// Whether particles at xi and xj (centre in xyz, radius in w) lie within r_i + r_j + skin of
+/// each other (nearest image): listed partners with the lists' skin (neighbour_scan), near
+/// partners with the near skin (fill_entries, contact_lists::restore).
+template <class Real>
+SPHERE_HDI bool within_skin(const world<Real>& box, const vec4<Real>& xi, const vec4<Real>& xj, Real skin)
+{
+    const Real reach = xi.w + xj.w + skin;
+    return norm2(box.nearest_image(xi.xyz() - xj.xyz())) < reach * reach;
+}
+
 /// Scans the cells around the particle at rank k and visits the partners it owns within reach
 /// (`pair(q)` with the partner's rank q) and then every active wall within r + skin
 /// (`wall(f)`). Owned partners lie in k's own layer at a higher rank or in the next layer,
@@ -191,9 +201,7 @@ private:
         unsigned q = grid.cell_start[first_cell];
         if (q < above) q = static_cast<unsigned>(above < end ? above : end);
         for (; q < end; ++q) {
-            const vec4<Real> xj = grid.sorted_x[q];
-            const Real reach = xi.w + xj.w + skin;
-            if (norm2(grid.geometry.box.nearest_image(xi.xyz() - xj.xyz())) < reach * reach) visit.pair(q);
+            if (within_skin(grid.geometry.box, xi, grid.sorted_x[q], skin)) visit.pair(q);
         }
     }
 };
@@ -245,15 +253,6 @@ struct old_lists {
     }
 };
 
-/// Whether particles at xi and xj (centre in xyz, radius in w) lie within r_i + r_j + near_skin
-/// of each other: near partners (fill_entries, contact_lists::restore).
-template <class Real>
-SPHERE_HDI bool near_partners(const world<Real>& box, const vec4<Real>& xi, const vec4<Real>& xj, Real near_skin)
-{
-    const Real reach = xi.w + xj.w + near_skin;
-    return norm2(box.nearest_image(xi.xyz() - xj.xyz())) < reach * reach;
-}
-
 /// Fills the new row of rank k: partners by rank (stored as slots: the rank itself once the
 /// particles are permuted into rank order, the grid's old slot with `keep_order`), the near
 /// partners first, walls last, and carries over the history each near contact had in the old
@@ -290,7 +289,7 @@ struct fill_entries {
         unsigned near = 0;
         for (unsigned a = 0; a < pairs; ++a) { // near partners to the front, both groups in order
             const unsigned q = p[a];
-            if (!near_partners(scan.grid.geometry.box, xi, scan.grid.sorted_x[q], near_skin)) continue;
+            if (!within_skin(scan.grid.geometry.box, xi, scan.grid.sorted_x[q], near_skin)) continue;
             for (unsigned b = a; b > near; --b) p[b] = p[b - 1];
             p[near++] = q;
         }
@@ -687,7 +686,7 @@ public:
             }
             std::sort(row.begin(), row.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
             const auto far = std::stable_partition(row.begin(), row.end(), [&](const auto& a) {
-                return detail::near_partners(g.box, x[r], x[a.first], near_skin);
+                return detail::within_skin(g.box, x[r], x[a.first], near_skin);
             });
             near_end[r] = static_cast<unsigned>(part.size() + std::size_t(far - row.begin()));
             std::sort(walls.begin(), walls.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
