@@ -84,21 +84,27 @@ struct slab_pairs {
         tile t;
         unsigned apart[tile::width]; // entries of pairs that do not touch
         int apart_count = 0;
-        const particle_view<P>& p = eval.p;
+        // Locals: the stores into the tile could alias the fields of *this, which the loop
+        // would otherwise reload for every entry.
+        const vec4<Coord>* const x = eval.p.x;
+        const unsigned* const partner = c.partner;
+        const auto* const flags = c.history.flags;
+        const world<Coord> box = eval.box;
+        const auto params = eval.params;
         for (unsigned r = first_rank; r < end_rank; ++r) {
             const unsigned i = static_cast<unsigned>(c.slot(r)), end = near_only ? c.near_end[r] : c.offset[r + 1];
-            const vec4<Coord> xi = p.x[i];
+            const vec4<Coord> xi = x[i];
             for (unsigned e = c.offset[r]; e < end; ++e) {
-                const unsigned j = c.partner[e];
+                const unsigned j = partner[e];
                 if (j >= wall_partner_base) break; // walls come last in a row
                 t.owner[t.count] = i;
                 t.partner[t.count] = j;
                 t.entry[t.count] = e;
                 // the sliding flag goes into the tile here: the SIMD loop gathers the
                 // displacements, but cannot gather bytes
-                t.hw[t.count] = Real(c.history.flags[e]);
+                t.hw[t.count] = Real(flags[e]);
                 pair_separation<Real> s;
-                const bool touching = eval.separate(xi, p.x[j], s);
+                const bool touching = sphere::detail::separate<Law>(params, box, xi, x[j], s);
                 t.dx[t.count] = s.d.x;
                 t.dy[t.count] = s.d.y;
                 t.dz[t.count] = s.d.z;
