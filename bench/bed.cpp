@@ -6,6 +6,7 @@
 //   build/bench/bed --csv bed_10000.csv [--precision double|float|mixed] [--threads 1] [--order file|shuffled]
 //                   [--tile 4 5]   (the periodic bed repeated 4 x 5 times in x and y: 1e6 particles from 50k)
 //                   [--rebuild]    (one rebuild of the contact lists after the untimed steps, for its memory)
+//                   [--summation automatic|slabs|gather]   (the pair sums' schedule; gather is CUDA's)
 //
 // Memory: the resident set (VmRSS, /proc/self/status) of the program with its input file, after the
 // untimed steps, and the whole process's peak (VmHWM), per particle (host backend only).
@@ -47,6 +48,7 @@ struct options {
     int threads = 1;
     bool audit = false;
     bool rebuild = false;
+    std::string summation = "automatic"; // automatic | slabs | gather
     std::size_t pre = 200, steps = 2000;
     std::vector<unsigned> tile{1, 1}; ///< copies of the periodic bed along x and y
 };
@@ -146,6 +148,8 @@ int run(const options& o, const bed_file& b)
     s.gravity = {0, 0, Real(-gravity)};
     s.dt = Real(dt);
     s.skin = Real(skin);
+    s.pair_summation = o.summation == "gather" ? pair_summation::gather
+                       : o.summation == "slabs" ? pair_summation::slabs : pair_summation::automatic;
     s.contact_forces = o.audit; // the scenario reads neither the contact forces nor the dissipation
     s.energy_audit = o.audit;
     s.angular_position = false; // nor the rotation angles
@@ -210,6 +214,8 @@ int main(int argc, char** argv)
         ->check(CLI::IsMember({"file", "shuffled"}));
     app.add_flag("--audit", o.audit, "record the contact forces and book the energy audit (as the defaults do)");
     app.add_flag("--rebuild", o.rebuild, "rebuild the contact lists once after the untimed steps (peak memory of a rebuild)");
+    app.add_option("--summation", o.summation, "the pair sums' schedule: automatic (the backend's), slabs or gather")
+        ->check(CLI::IsMember({"automatic", "slabs", "gather"}));
     app.add_option("--pre", o.pre, "untimed steps before the first count");
     app.add_option("--steps", o.steps, "timed steps");
     app.add_option("--tile", o.tile, "copies of the periodic bed along x and y (e.g. 4 5: 1e6 particles from 50k)")

@@ -520,12 +520,15 @@ TEMPLATE_TEST_CASE("walking only the near partners gives the bits of walking eve
 {
     using P = TestType;
     using Real = sphere_test::user_real<P>;
-    // While no particle has moved half the near skin since the last rebuild, the slab
-    // schedule walks each row's near partners alone (docs/architecture.md, *Near partners*).
-    // A restored simulation does not know whether the others are clear of history and walks
-    // every entry at its first step: the original, which walks the near ones alone at that
-    // step, must give the same bits, then and after.
-    const auto setup = assembly<Real>(8, Real(0.002), 43);
+    // While no particle has moved half the near skin since the last rebuild, the pair sums
+    // walk each row's near partners alone (docs/architecture.md, *Near partners*). A restored
+    // simulation does not know whether the others are clear of history (nor, on the gather
+    // schedule, whether their stored results are zero) and walks every entry at its first
+    // step: the original, which walks the near ones alone at that step, must give the same
+    // bits, then and after.
+    auto setup = assembly<Real>(8, Real(0.002), 43);
+    SECTION("pair sums by slabs") { setup.first.pair_summation = sphere::pair_summation::slabs; }
+    SECTION("pair sums by gather") { setup.first.pair_summation = sphere::pair_summation::gather; }
     sphere::simulation<P> original(setup.first, setup.second);
     original.run(30);
     sphere::simulation_state<Real> before = original.state();
@@ -562,11 +565,12 @@ TEMPLATE_TEST_CASE("colliding particles whose partners come near and touch betwe
 {
     using P = TestType;
     using Real = sphere_test::user_real<P>;
-    // The gather schedule walks every listed pair at every step; the slab schedule walks the
-    // near partners alone while the others cannot touch, then all of them. Pairs listed apart
-    // from the near ones come into contact between rebuilds here: were one missed, or had it
-    // kept a history from an earlier contact, the forces would differ by far more than the
-    // order of the additions makes them.
+    // Both schedules walk the near partners alone while the others cannot touch, then all of
+    // them; the gather schedule also walks all of them at the first step after a rebuild, which
+    // stores the others' zero results that its sums add up later. Pairs listed apart from the
+    // near ones come into contact between rebuilds here: were one missed, or had it kept a
+    // history (or, on gather, a stored result) from an earlier contact, the forces would differ
+    // by far more than the order of the additions makes them.
     const auto setup = assembly<Real>(10, Real(0.002), 44);
     auto run = [&](sphere::pair_summation how, std::size_t steps) {
         sphere::settings<Real> s = setup.first;
@@ -577,7 +581,7 @@ TEMPLATE_TEST_CASE("colliding particles whose partners come near and touch betwe
     };
     const std::size_t steps = 60;
     const auto [a, walks] = run(sphere::pair_summation::slabs, steps);
-    const auto b = run(sphere::pair_summation::gather, steps).first;
+    const auto [b, gather_walks] = run(sphere::pair_summation::gather, steps);
     require_eventful(a);
     double dx = 0, dv = 0, v_scale = 0;
     for (std::size_t i = 0; i < a.snap.size(); ++i) {
@@ -585,11 +589,13 @@ TEMPLATE_TEST_CASE("colliding particles whose partners come near and touch betwe
         dv = std::max(dv, double(sphere::norm(a.snap.v[i] - b.snap.v[i])));
         v_scale = std::max(v_scale, double(sphere::norm(a.snap.v[i])));
     }
-    INFO(walks << " of " << steps << " steps on the near partners alone, " << a.rebuilds
-               << " rebuilds; largest position difference " << dx << " m, velocity difference " << dv << " of "
-               << v_scale << " m/s");
+    INFO(walks << " (slabs) and " << gather_walks << " (gather) of " << steps << " steps on the near partners alone, "
+               << a.rebuilds << " rebuilds; largest position difference " << dx << " m, velocity difference " << dv
+               << " of " << v_scale << " m/s");
     CHECK(walks > 0);
     CHECK(walks < steps);
+    CHECK(gather_walks > 0);
+    CHECK(gather_walks < walks); // not at the steps after the rebuilds
     CHECK(a.rebuilds > 2);
     CHECK(same_bytes(a.contacts.partner, b.contacts.partner));
     const double tol = sphere_test::single_fields<P> ? 1e-4 : 1e-10;

@@ -478,8 +478,9 @@ public:
     /// How many times the grid and contact lists were built (including at setup).
     std::size_t rebuilds() const { return rebuilds_; }
     /// How many of this simulation object's steps summed the pair contacts walking only each
-    /// row's near partners (the host's slab schedule, while no particle has moved half the near
-    /// skin since the last rebuild: docs/architecture.md, *Near partners*). Not in the state.
+    /// row's near partners (while no particle has moved half the near skin since the last
+    /// rebuild, and on the gather schedule not at the first step after a rebuild or restore:
+    /// docs/architecture.md, *Near partners*). Not in the state.
     std::size_t near_walks() const { return near_walks_; }
     /// The deepest overlap the particles started with, as a fraction of the smaller radius (of
     /// the particle's at a wall); settings.max_initial_overlap bounds it.
@@ -909,7 +910,6 @@ private:
         // walk the near ones alone (their histories are clear: docs/architecture.md).
         const bool apart = rebuild || near_holds();
         const bool near_only = apart && (rebuild || far_clear_);
-        if (near_only && summation_ == pair_summation::slabs) ++near_walks_;
         detail::step_report<Coord> done{};
         do {
             if (rebuild) rebuild_lists(&report->lists);
@@ -940,6 +940,7 @@ private:
                                "the step's report (wall loads, particle check, drive power, list totals)", steps_ + 1);
         } while (rebuild && !settle_rebuild(done.lists));
         far_clear_ = apart; // the walk has cleared their histories, or found them touching
+        if (interaction_.walked_near()) ++near_walks_;
         advance_walls(walls_, settings_.walls, settings_.box, done.loads.force, time_, dt_, steps_ + 1);
         if (drive_) drive_work_ += done.drive_power * double(dt_);
         ++steps_;
@@ -957,7 +958,7 @@ private:
             if (steps_ % o.first == 0) o.second(*this);
     }
 
-    /// The pair sums (`near_only`: on the slab schedule, the near partners alone), the walls,
+    /// The pair sums (`near_only`: the near partners alone, interaction::sum_pairs), the walls,
     /// `body` (the integration after the forces) and the particle check `checks`: in one
     /// parallel region on the host's slab schedule, else pass after pass. Leaves the wall loads and the check's largest squared displacement in `report`
     /// (policy memory).

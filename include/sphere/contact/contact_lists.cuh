@@ -11,7 +11,7 @@
 /// within r_a + r_b + near skin at the rebuild (its *near* partners), then the others, each
 /// group by partner rank, then every wall face within r + skin (by face). While no particle
 /// has moved more than half the near skin since the rebuild, the others cannot touch, and the
-/// host's pair sums walk the near partners alone (docs/architecture.md, *Near partners*).
+/// pair sums walk the near partners alone (docs/architecture.md, *Near partners*).
 /// Each entry holds the contact's history (tangential displacement as seen by the owner,
 /// sliding flag) and, when recorded, the force of the last step. The lists hold what they
 /// find: no capacity to set.

@@ -362,7 +362,9 @@ struct no_finish {
 };
 
 /// The gather schedule, first pass (one index per rank): evaluates the owner's pairs and
-/// stores each pair's result.
+/// stores each pair's result. `near_only`: the owner's near partners alone (the caller knows
+/// that the others are apart and that their stored results are zero from the walk that last
+/// found them apart).
 template <class P, class Law, bool Book, bool Record, bool OneVelocity>
 struct evaluate_owned_pairs {
     using Real = real_t<P>;
@@ -373,11 +375,12 @@ struct evaluate_owned_pairs {
     vec3<Real>* torque_j;
     vec3<Real>* audit; ///< |f_n|, half the viscous and half the frictional rate (Book only)
     bool update_history;
+    bool near_only;
 
     SPHERE_HD void operator()(std::size_t r) const
     {
         const std::size_t i = c.slot(r);
-        const unsigned end = c.offset[r + 1];
+        const unsigned end = near_only ? c.near_end[r] : c.offset[r + 1];
         for (unsigned e = c.offset[r]; e < end; ++e) {
             const unsigned j = c.partner[e];
             if (j >= wall_partner_base) break;
@@ -473,15 +476,25 @@ public:
     }
 
     /// The contact lists were rebuilt or replaced.
-    void lists_changed() { reverse_ready_ = false; }
+    void lists_changed()
+    {
+        reverse_ready_ = false;
+        results_walked_ = false;
+    }
+
+    /// Whether the last sum_pairs walked the near partners alone.
+    bool walked_near() const { return walked_near_; }
 
     /// Overwrites every particle's force and torque (and, with Book, its |f_n| sum and
     /// dissipation rates) with the sums over its pair contacts. Book implies update_history.
     /// On the slab schedule, each thread then runs `finish(first_rank, end_rank, thread)` on a
     /// block of ranks (all ranks in all), in the same parallel region; returns whether it did,
-    /// so that the caller runs that work otherwise. `near_only`: the slab schedule walks only
-    /// the near partners of each row, which the caller has found to be the only ones that can
-    /// touch, the others having no history (the gather schedule walks every entry).
+    /// so that the caller runs that work otherwise. `near_only`: walk only the near partners of
+    /// each row, which the caller has found to be the only ones that can touch, the others
+    /// having no history and having been apart at the last walk that visited them. The gather
+    /// schedule, which adds up the stored results of every entry, does so only once a walk of
+    /// every entry since the lists changed (with the audit, when Book) has stored the others'
+    /// zeros (walked_near() says whether it did).
     template <bool Book, bool Record, class Law, bool OneVelocity, class Finish = detail::no_finish>
     bool sum_pairs(execution_context<Policy>& ctx, const detail::pair_contact<P, Law, OneVelocity>& eval,
                    contact_lists<P, Policy>& lists, pair_summation how, bool update_history, bool near_only = false,
@@ -495,6 +508,7 @@ public:
                 detail::sum_by_slabs(detail::slab_pairs<P, Law, Book, Record, OneVelocity>{eval, c, update_history, near_only},
                                      detail::zero_pair_sums<P, Book>{p}, finish, p.n, lists.layer_start(), phases);
             }
+            walked_near_ = near_only;
             return true;
         }
         // sized by the lists' capacity, which the host knows without waiting for a rebuild's totals
@@ -503,13 +517,22 @@ public:
             force_.resize(entries);
             torque_i_.resize(entries);
             torque_j_.resize(entries);
+            results_walked_ = false;
         }
-        if (Book && audit_.size() < entries) audit_.resize(entries);
+        if (Book && audit_.size() < entries) {
+            audit_.resize(entries);
+            results_walked_ = false;
+        }
         if (!reverse_ready_) build_reverse(ctx, c, entries, p.n);
+        walked_near_ = near_only && results_walked_ && (results_audited_ || !Book);
         for_each_index(Policy{}, p.n,
                        detail::evaluate_owned_pairs<P, Law, Book, Record, OneVelocity>{
                            eval, c, force_.data(), torque_i_.data(), torque_j_.data(), Book ? audit_.data() : nullptr,
-                           update_history});
+                           update_history, walked_near_});
+        if (!walked_near_) {
+            results_walked_ = true;
+            results_audited_ = Book;
+        }
         for_each_index(Policy{}, p.n,
                        detail::gather_pair_results<P, Book>{p, c, reverse_offset_.data(), reverse_entry_.data(),
                                                             force_.data(), torque_i_.data(), torque_j_.data(),
@@ -534,6 +557,9 @@ private:
     buffer<vec3<Real>, Policy> force_, torque_i_, torque_j_, audit_;
     buffer<unsigned, Policy> reverse_offset_, reverse_key_, reverse_entry_;
     bool reverse_ready_ = false;
+    bool results_walked_ = false;  ///< every entry's result stored since the lists changed (gather)
+    bool results_audited_ = false; ///< and its audit sums too
+    bool walked_near_ = false;     ///< walked_near()
 };
 
 } // namespace sphere
