@@ -493,8 +493,9 @@ public:
     /// each row, which the caller has found to be the only ones that can touch, the others
     /// having no history and having been apart at the last walk that visited them. The gather
     /// schedule, which adds up the stored results of every entry, does so only once a walk of
-    /// every entry since the lists changed (with the audit, when Book) has stored the others'
-    /// zeros (walked_near() says whether it did).
+    /// every entry since the lists changed has stored the others' zeros (walked_near() says
+    /// whether it did). A simulation's Book is fixed (its initial forces, without the audit,
+    /// come before the audit's buffer exists), so that walk stored the audit sums too.
     template <bool Book, bool Record, class Law, bool OneVelocity, class Finish = detail::no_finish>
     bool sum_pairs(execution_context<Policy>& ctx, const detail::pair_contact<P, Law, OneVelocity>& eval,
                    contact_lists<P, Policy>& lists, pair_summation how, bool update_history, bool near_only = false,
@@ -524,15 +525,12 @@ public:
             results_walked_ = false;
         }
         if (!reverse_ready_) build_reverse(ctx, c, entries, p.n);
-        walked_near_ = near_only && results_walked_ && (results_audited_ || !Book);
+        walked_near_ = near_only && results_walked_;
         for_each_index(Policy{}, p.n,
                        detail::evaluate_owned_pairs<P, Law, Book, Record, OneVelocity>{
                            eval, c, force_.data(), torque_i_.data(), torque_j_.data(), Book ? audit_.data() : nullptr,
                            update_history, walked_near_});
-        if (!walked_near_) {
-            results_walked_ = true;
-            results_audited_ = Book;
-        }
+        if (!walked_near_) results_walked_ = true;
         for_each_index(Policy{}, p.n,
                        detail::gather_pair_results<P, Book>{p, c, reverse_offset_.data(), reverse_entry_.data(),
                                                             force_.data(), torque_i_.data(), torque_j_.data(),
@@ -557,9 +555,8 @@ private:
     buffer<vec3<Real>, Policy> force_, torque_i_, torque_j_, audit_;
     buffer<unsigned, Policy> reverse_offset_, reverse_key_, reverse_entry_;
     bool reverse_ready_ = false;
-    bool results_walked_ = false;  ///< every entry's result stored since the lists changed (gather)
-    bool results_audited_ = false; ///< and its audit sums too
-    bool walked_near_ = false;     ///< walked_near()
+    bool results_walked_ = false; ///< every entry's result stored since the lists changed (gather)
+    bool walked_near_ = false;    ///< walked_near()
 };
 
 } // namespace sphere
