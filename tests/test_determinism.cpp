@@ -566,8 +566,8 @@ TEMPLATE_TEST_CASE("colliding particles whose partners come near and touch betwe
     using P = TestType;
     using Real = sphere_test::user_real<P>;
     // Both schedules walk the near partners alone while the others cannot touch, then all of
-    // them; the gather schedule also walks all of them at the first step after a rebuild, which
-    // stores the others' zero results that its sums add up later. Pairs listed apart from the
+    // them; the gather schedule also walks all of them at each step that rebuilds, which stores
+    // the others' zero results that its sums add up later. Pairs listed apart from the
     // near ones come into contact between rebuilds here: were one missed, or had it kept a
     // history (or, on gather, a stored result) from an earlier contact, the forces would differ
     // by far more than the order of the additions makes them.
@@ -595,7 +595,7 @@ TEMPLATE_TEST_CASE("colliding particles whose partners come near and touch betwe
     CHECK(walks > 0);
     CHECK(walks < steps);
     CHECK(gather_walks > 0);
-    CHECK(gather_walks < walks); // not at the steps after the rebuilds
+    CHECK(gather_walks < walks); // not at the steps that rebuild
     CHECK(a.rebuilds > 2);
     CHECK(same_bytes(a.contacts.partner, b.contacts.partner));
     const double tol = sphere_test::single_fields<P> ? 1e-4 : 1e-10;

@@ -479,8 +479,8 @@ public:
     std::size_t rebuilds() const { return rebuilds_; }
     /// How many of this simulation object's steps summed the pair contacts walking only each
     /// row's near partners (while no particle has moved half the near skin since the last
-    /// rebuild, and on the gather schedule not at the first step after a rebuild or restore:
-    /// docs/architecture.md, *Near partners*). Not in the state.
+    /// rebuild, and on the gather schedule not at a step that rebuilds nor at the first after a
+    /// restore: docs/architecture.md, *Near partners*). Not in the state.
     std::size_t near_walks() const { return near_walks_; }
     /// The deepest overlap the particles started with, as a fraction of the smaller radius (of
     /// the particle's at a wall); settings.max_initial_overlap bounds it.
