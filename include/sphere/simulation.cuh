@@ -960,8 +960,8 @@ private:
 
     /// The pair sums (`near_only`: the near partners alone, interaction::sum_pairs), the walls,
     /// `body` (the integration after the forces) and the particle check `checks`: in one
-    /// parallel region on the host's slab schedule, else pass after pass. Leaves the wall loads and the check's largest squared displacement in `report`
-    /// (policy memory).
+    /// parallel region on the host's slab schedule, else pass after pass. Leaves the wall loads
+    /// and the check's largest squared displacement in `report` (policy memory).
     template <bool Book, bool Record, class Body, class Check>
     void finish_step(const Body& body, const Check& checks, detail::step_report<Coord>* report, bool near_only)
     {
