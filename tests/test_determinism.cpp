@@ -326,6 +326,67 @@ TEMPLATE_TEST_CASE("the storage order does not change the physics: reordering on
     SECTION("velocity Verlet") { compare(sphere::integrate::velocity_verlet{}); }
 }
 
+/// The record of a simulation whose last particle is left out: its snapshot's fields and the
+/// contact offsets truncated to the others (the contact tables' entries stay: the left-out
+/// particle must have none, or they differ).
+template <class Real>
+record<Real> without_last(record<Real> r)
+{
+    auto& s = r.snap;
+    const std::size_t n = s.size() - 1;
+    s.x.resize(n);
+    for (auto* f : {&s.v, &s.omega, &s.v_sync, &s.omega_sync, &s.angpos, &s.force, &s.torque, &s.displacement})
+        if (!f->empty()) f->resize(n);
+    for (auto* f : {&s.mass, &s.pressure, &s.e_visc, &s.e_fric, &s.p_visc, &s.p_fric})
+        if (!f->empty()) f->resize(n);
+    s.kind.resize(n);
+    s.material.resize(n);
+    r.contacts.offset.resize(n + 1);
+    return r;
+}
+
+TEMPLATE_TEST_CASE("free particles move by the same bits in a simulation of free particles only and beside a fixed one",
+                   "[determinism]", float, double, sphere::mixed)
+{
+    using P = TestType;
+    using Real = sphere_test::user_real<P>;
+    // On the host, a simulation whose particles are all free integrates them without loading
+    // their motion kinds (integrate/integrate_particles.cuh, kind_of). The same particles
+    // beside one fixed particle, out of everyone's reach, take the general path: their motion
+    // must be the same bits.
+    auto setup = assembly<Real>(7, Real(0.002), 5); // 343 particles
+    const double r0 = 0.01;
+    setup.first.box.hi.z += Real(8 * r0); // room above the assembly for the fixed particle
+    for (auto& p : setup.second) p.kind = sphere::motion::free;
+    auto beside = setup.second;
+    sphere::particle<Real> fixed;
+    fixed.radius = Real(r0);
+    fixed.density = Real(2500);
+    fixed.position = {Real(0), Real(0), Real(double(setup.first.box.hi.z) - 2 * r0)};
+    fixed.kind = sphere::motion::fixed;
+    beside.push_back(fixed);
+    auto compare = [&](auto integrator) {
+        using sim_type = sphere::simulation<P, sphere::host, sphere::contact::linear<>, decltype(integrator)>;
+        sim_type alone(setup.first, setup.second), with_fixed(setup.first, beside);
+        alone.run(200);
+        with_fixed.run(200);
+        const auto a = record_of(alone), b = record_of(with_fixed);
+        require_eventful(a);
+        const std::size_t last = b.snap.size() - 1;
+        CHECK(b.snap.position(last) == fixed.position); // it stayed
+        CHECK(b.contacts.begin(last) == b.contacts.end(last)); // out of everyone's reach
+        std::vector<std::string> diff = differences(a, without_last(b));
+        // Sums over all particles (energy, momentum) also hold the fixed one's share.
+        diff.erase(std::remove_if(diff.begin(), diff.end(),
+                                  [](const std::string& f) { return f == "energy budget" || f == "momentum"; }),
+                   diff.end());
+        INFO("fields that differ: " << Catch::Detail::stringify(diff));
+        CHECK(diff.empty());
+    };
+    SECTION("semi-implicit Euler") { compare(sphere::integrate::semi_implicit_euler{}); }
+    SECTION("velocity Verlet") { compare(sphere::integrate::velocity_verlet{}); }
+}
+
 TEMPLATE_TEST_CASE("switching off what a run does not read (audit, contact forces, angular positions, displacements) "
                    "keeps the motion's bits",
                    "[determinism][memory]", float, double, sphere::mixed)

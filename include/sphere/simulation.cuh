@@ -363,6 +363,7 @@ public:
             kinds_.push_back(p.kind);
             if (p.kind == motion::prescribed || p.kind == motion::prescribed_horizontal) drive_ = true;
         }
+        all_free_ = std::all_of(kinds_.begin(), kinds_.end(), [](motion k) { return k == motion::free; });
         const std::size_t n = particles.size();
         std::vector<particle<Coord>>().swap(particles); // copied: its memory is not held through the first build
         walls_ = wall_set<Coord>::from_world(s.box);
@@ -666,6 +667,7 @@ public:
                 detail::fail("restore: particle ", i, " has motion kind ", unsigned(s.particles.kind[i]), ", at most ",
                              unsigned(last_motion), " is valid");
         for (std::size_t i = 0; i < size(); ++i) kinds_[i] = static_cast<motion>(s.particles.kind[i]);
+        all_free_ = std::all_of(kinds_.begin(), kinds_.end(), [](motion k) { return k == motion::free; });
         for (std::size_t i = 0; i < size(); ++i) check_material(i, s.particles.material[i], "restore: ");
         if (s.x_at_build.size() != size())
             detail::fail("restore: the state holds ", s.x_at_build.size(), " build positions for ", size(), " particles");
@@ -868,9 +870,21 @@ private:
     }
 
     /// One step with the switches of the settings: `Book` the energy audit, `Record` each
-    /// contact's force. The particle check runs in the same pass as the motion: after the
-    /// drift (velocity Verlet) or after the integration.
+    /// contact's force. On the host, a simulation whose particles are all free integrates
+    /// them without loading their kinds (detail::kind_of; the same bits).
     template <bool External, bool Book, bool Record>
+    void step_with()
+    {
+        if constexpr (runs_in_blocks<Policy>) {
+            if (all_free_) return step_with<External, Book, Record, true>();
+        }
+        step_with<External, Book, Record, false>();
+    }
+
+    /// One step (step_with above), `AllFree`: every particle is free. The particle check runs
+    /// in the same pass as the motion: after the drift (velocity Verlet) or after the
+    /// integration.
+    template <bool External, bool Book, bool Record, bool AllFree>
     void step_with()
     {
         // Views hold raw pointers into arrays that a rebuild permutes in place (their
@@ -880,10 +894,10 @@ private:
         const vec3<Real>* external = External ? external_loads() : nullptr;
         const vec3<Real>* external_torque = External && bonds_.size() ? load_torque_.data() : nullptr;
         constexpr bool drifted = Integrator::drifts_before_forces;
-        const detail::integrate_particles<Precision, Integrator, External> integrate{
+        const detail::integrate_particles<Precision, Integrator, External, AllFree> integrate{
             p, settings_.box, gravity_, Real(dt_), external, external_torque};
-        const detail::drift_particles<Precision, Integrator, External> drift{p, settings_.box, gravity_, Real(dt_),
-                                                                            external, external_torque};
+        const detail::drift_particles<Precision, Integrator, External, AllFree> drift{
+            p, settings_.box, gravity_, Real(dt_), external, external_torque};
         detail::step_report<Coord>* report = report_.data(); // policy memory
         const unsigned* halt = &report->lists.overflow;
         // The drift's loads: the bonds' of the last step with the external forces written since.
@@ -925,7 +939,8 @@ private:
                 }
             };
             if constexpr (!drifted) finish(check());
-            else if (predicts_drift()) finish(detail::check_after_drift<Precision, Integrator, External>{drift, check()});
+            else if (predicts_drift())
+                finish(detail::check_after_drift<Precision, Integrator, External, AllFree>{drift, check()});
             else finish(detail::no_check<Coord>{});
             if constexpr (!drifted) turn(halt);
             if (drive_)
@@ -1339,6 +1354,7 @@ private:
     bool far_clear_ = true;      ///< the lists' other partners (not near) have no history
     std::size_t near_walks_ = 0; ///< near_walks()
     std::vector<motion> kinds_; ///< host copy of each particle's motion (it never changes)
+    bool all_free_ = false;     ///< every particle's motion is motion::free
     std::vector<std::pair<std::size_t, observer>> observers_;
     thread_governor governor_; ///< all threads or one, whichever is faster on this machine now
     bond_params<Real> bond_params_; ///< settings_.bond in the particles' precision

@@ -58,6 +58,16 @@ SPHERE_HDI void accelerations(const particle_view<P>& p, std::size_t i, motion k
     alpha = torque * (kind == motion::free ? Real(1) / (Real(0.4) * m * r * r) : Real(0));
 }
 
+/// Particle i's motion kind, or motion::free without loading it when `AllFree` (every
+/// particle is free). The kinds are bytes: a loop over particles that loads them is
+/// vectorised by g++ with 64 lanes (one byte vector), whose spills and scalar remainder made
+/// the drift a third slower on the dense bed (docs/performance.md); without them it takes 8.
+template <bool AllFree, class P>
+SPHERE_HDI motion kind_of(const particle_view<P>& p, std::size_t i)
+{
+    return AllFree ? motion::free : static_cast<motion>(p.kind[i]);
+}
+
 /// Advances particle i by dt after the forces: free particles with the integrator policy,
 /// prescribed ones at their own velocities, horizontally prescribed ones at their own x, y and
 /// angular velocities and along z under the contact force alone, fixed ones not at all. Also
@@ -68,8 +78,8 @@ SPHERE_HDI void accelerations(const particle_view<P>& p, std::size_t i, motion k
 /// Every kind goes through the integrator with its own accelerations: zero for prescribed and
 /// fixed ones, whose velocities therefore stay (a fixed particle's are zero, so it stays where
 /// it is). No kind selects what is stored: the compiler would turn that into conditional loads
-/// and stores, which SIMD lanes cannot do.
-template <class P, class Integrator, bool External = false>
+/// and stores, which SIMD lanes cannot do. `AllFree`: every particle is free (kind_of).
+template <class P, class Integrator, bool External = false, bool AllFree = false>
 struct integrate_particles {
     using Real = real_t<P>;
     using Coord = coord_t<P>;
@@ -83,7 +93,7 @@ struct integrate_particles {
     SPHERE_HDI void operator()(std::size_t i) const
     {
         constexpr bool drifted = Integrator::drifts_before_forces;
-        const auto kind = static_cast<motion>(p.kind[i]);
+        const auto kind = kind_of<AllFree>(p, i);
         vec4<Coord> x = p.x[i]; // aggregates not const: see the note in contact/evaluate.cuh
         vec3<Coord> pos = x.xyz();
         vec3<Real> v = p.v[i], w = p.omega[i], angle{0, 0, 0}; // angles are turn_particles' (not stored here)
@@ -107,8 +117,8 @@ struct integrate_particles {
 /// The part of an integrator's step before the forces (velocity Verlet's first half kick,
 /// with the forces of the last step, and its drift): every kind by Integrator::drift with its
 /// own accelerations, as in integrate_particles. The dashpots of the next force evaluation see
-/// the velocities between the kicks.
-template <class P, class Integrator, bool External = false>
+/// the velocities between the kicks. `AllFree`: every particle is free (kind_of).
+template <class P, class Integrator, bool External = false, bool AllFree = false>
 struct drift_particles {
     using Real = real_t<P>;
     using Coord = coord_t<P>;
@@ -126,7 +136,7 @@ struct drift_particles {
         static_assert(!Integrator::distinct_synchronous_velocity, "a drifting integrator keeps one velocity");
         pos = p.x[i].xyz();
         v = p.v[i];
-        const vec3<Real> a = linear_acceleration<External>(p, i, static_cast<motion>(p.kind[i]), gravity, external);
+        const vec3<Real> a = linear_acceleration<External>(p, i, kind_of<AllFree>(p, i), gravity, external);
         Integrator::drift(pos, v, a, dt);
         pos = box.wrap(pos);
     }
@@ -137,7 +147,7 @@ struct drift_particles {
         vec3<Real> v;
         drifted(i, pos, v);
         vec3<Real> w = p.omega[i], angle{0, 0, 0}, a, alpha; // angles are turn_particles' (not stored here)
-        accelerations<External>(p, i, static_cast<motion>(p.kind[i]), gravity, external, external_torque, a, alpha);
+        accelerations<External>(p, i, kind_of<AllFree>(p, i), gravity, external, external_torque, a, alpha);
         Integrator::drift(angle, w, alpha, dt);
         p.x[i] = {pos.x, pos.y, pos.z, p.x[i].w};
         p.v[i] = v;
@@ -215,9 +225,9 @@ struct check_particle {
 /// The check of particle i at the position the next drift will give it (velocity Verlet, at
 /// the end of a step: the host then decides the next step's rebuild without waiting for the
 /// drift). Against the walls where they stand now, before they move.
-template <class P, class Integrator, bool External>
+template <class P, class Integrator, bool External, bool AllFree = false>
 struct check_after_drift {
-    drift_particles<P, Integrator, External> drift;
+    drift_particles<P, Integrator, External, AllFree> drift;
     check_particle<P> check;
     SPHERE_HDI coord_t<P> operator()(std::size_t i) const
     {
