@@ -60,8 +60,8 @@ SPHERE_HDI void accelerations(const particle_view<P>& p, std::size_t i, motion k
 
 /// Particle i's motion kind, or motion::free without loading it when `AllFree` (every
 /// particle is free). The kinds are bytes: a loop over particles that loads them is
-/// vectorised by g++ with 64 lanes (one byte vector), whose spills and scalar remainder made
-/// the drift a third slower on the dense bed (docs/performance.md); without them it takes 8.
+/// vectorised by g++ with 64 lanes (one byte vector), whose spills and scalar remainder gave
+/// the drift 60% more time on the dense bed (docs/performance.md); without them it takes 8.
 template <bool AllFree, class P>
 SPHERE_HDI motion kind_of(const particle_view<P>& p, std::size_t i)
 {
