@@ -350,10 +350,11 @@ TEMPLATE_TEST_CASE("free particles move by the same bits in a simulation of free
 {
     using P = TestType;
     using Real = sphere_test::user_real<P>;
-    // On the host, a simulation whose particles are all free integrates them without loading
-    // their motion kinds (integrate/integrate_particles.cuh, kind_of). The same particles
-    // beside one fixed particle, out of everyone's reach, take the general path: their motion
-    // must be the same bits.
+    // On the host's slab schedule, a simulation whose particles are all free (and without
+    // external forces) integrates them without loading their motion kinds
+    // (integrate/integrate_particles.cuh, kind_of). The same particles beside one fixed
+    // particle, out of everyone's reach, take the general path: their motion must be the same
+    // bits.
     auto setup = assembly<Real>(7, Real(0.002), 5); // 343 particles
     const double r0 = 0.01;
     setup.first.box.hi.z += Real(8 * r0); // room above the assembly for the fixed particle

@@ -870,20 +870,23 @@ private:
     }
 
     /// One step with the switches of the settings: `Book` the energy audit, `Record` each
-    /// contact's force. On the host, a simulation whose particles are all free integrates
-    /// them without loading their kinds (detail::kind_of; the same bits).
+    /// contact's force. On the host's slab schedule, a simulation whose particles are all free
+    /// and without external forces integrates them without loading their kinds
+    /// (detail::kind_of; the same bits). Each such variant of the step is compiled in full, so
+    /// only that schedule gets one, and not the steps of the pore fluid and the bonds, which
+    /// their own passes dominate.
     template <bool External, bool Book, bool Record>
     void step_with()
     {
-        if constexpr (runs_in_blocks<Policy>) {
-            if (all_free_) return step_with<External, Book, Record, true>();
+        if constexpr (runs_in_blocks<Policy> && !External) {
+            if (all_free_ && summation_ == pair_summation::slabs) return step_with<External, Book, Record, true>();
         }
         step_with<External, Book, Record, false>();
     }
 
-    /// One step (step_with above), `AllFree`: every particle is free. The particle check runs
-    /// in the same pass as the motion: after the drift (velocity Verlet) or after the
-    /// integration.
+    /// One step (step_with above), `AllFree`: every particle is free, and the schedule is the
+    /// slab schedule (the gather schedule's passes are left out). The particle check runs in
+    /// the same pass as the motion: after the drift (velocity Verlet) or after the integration.
     template <bool External, bool Book, bool Record, bool AllFree>
     void step_with()
     {
@@ -906,8 +909,8 @@ private:
             // The last step's report checked the positions this drift gives (check_after_drift),
             // unless the host has changed something the drift reads since: then the drift
             // checks them itself, and the host waits for that check before deciding on a rebuild.
-            if (drift_checked_) {
-                for_each_index(Policy{}, n, drift);
+            if (drift_checked_) { // only after the gather schedule's prediction (predicts_drift)
+                if constexpr (!AllFree) for_each_index(Policy{}, n, drift);
             } else {
                 checked_into(drift, check(), &report->moved2);
                 Coord moved2 = 0;
@@ -933,15 +936,18 @@ private:
                 if constexpr (Book) {
                     const detail::both<detail::finish_audit<Precision>, decltype(integrate)> body{{p, Real(dt_)},
                                                                                                    integrate};
-                    finish_step<Book, Record>(body, checks, report, near_only);
+                    finish_step<Book, Record, AllFree>(body, checks, report, near_only);
                 } else {
-                    finish_step<Book, Record>(integrate, checks, report, near_only);
+                    finish_step<Book, Record, AllFree>(integrate, checks, report, near_only);
                 }
             };
-            if constexpr (!drifted) finish(check());
-            else if (predicts_drift())
-                finish(detail::check_after_drift<Precision, Integrator, External, AllFree>{drift, check()});
-            else finish(detail::no_check<Coord>{});
+            if constexpr (!drifted) {
+                finish(check());
+            } else if (predicts_drift()) {
+                if constexpr (!AllFree) finish(detail::check_after_drift<Precision, Integrator, External>{drift, check()});
+            } else {
+                finish(detail::no_check<Coord>{});
+            }
             if constexpr (!drifted) turn(halt);
             if (drive_)
                 transform_reduce_into(context_, n,
@@ -976,8 +982,9 @@ private:
     /// The pair sums (`near_only`: the near partners alone, interaction::sum_pairs), the walls,
     /// `body` (the integration after the forces) and the particle check `checks`: in one
     /// parallel region on the host's slab schedule, else pass after pass. Leaves the wall loads
-    /// and the check's largest squared displacement in `report` (policy memory).
-    template <bool Book, bool Record, class Body, class Check>
+    /// and the check's largest squared displacement in `report` (policy memory). `SlabsOnly`:
+    /// the schedule is the slab schedule (the other passes are not compiled).
+    template <bool Book, bool Record, bool SlabsOnly, class Body, class Check>
     void finish_step(const Body& body, const Check& checks, detail::step_report<Coord>* report, bool near_only)
     {
         const auto walls = wall_contacts<Book, Record>(true);
@@ -999,9 +1006,11 @@ private:
         } else {
             interaction_.template sum_pairs<Book, Record>(context_, pair_contact(), lists_, summation_, true);
         }
-        transform_reduce_into(context_, wall_launch_, walls, detail::wall_loads{{0, 0, 0, 0, 0, 0}}, plus_op{},
-                              &report->loads);
-        checked_into(detail::unless_halted<Body>{body, halt}, checks, &report->moved2);
+        if constexpr (!SlabsOnly) {
+            transform_reduce_into(context_, wall_launch_, walls, detail::wall_loads{{0, 0, 0, 0, 0, 0}}, plus_op{},
+                                  &report->loads);
+            checked_into(detail::unless_halted<Body>{body, halt}, checks, &report->moved2);
+        }
     }
 
     /// Whether velocity Verlet's step ends with the check of where its next drift puts the

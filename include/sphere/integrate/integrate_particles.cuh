@@ -225,9 +225,9 @@ struct check_particle {
 /// The check of particle i at the position the next drift will give it (velocity Verlet, at
 /// the end of a step: the host then decides the next step's rebuild without waiting for the
 /// drift). Against the walls where they stand now, before they move.
-template <class P, class Integrator, bool External, bool AllFree = false>
+template <class P, class Integrator, bool External>
 struct check_after_drift {
-    drift_particles<P, Integrator, External, AllFree> drift;
+    drift_particles<P, Integrator, External> drift;
     check_particle<P> check;
     SPHERE_HDI coord_t<P> operator()(std::size_t i) const
     {
