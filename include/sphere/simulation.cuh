@@ -879,7 +879,8 @@ private:
     void step_with()
     {
         if constexpr (runs_in_blocks<Policy> && !External) {
-            if (all_free_ && summation_ == pair_summation::slabs) return step_with<External, Book, Record, true>();
+            if (all_free_ && summation_ == pair_summation::slabs && !drift_checked_)
+                return step_with<External, Book, Record, true>();
         }
         step_with<External, Book, Record, false>();
     }
@@ -909,7 +910,7 @@ private:
             // The last step's report checked the positions this drift gives (check_after_drift),
             // unless the host has changed something the drift reads since: then the drift
             // checks them itself, and the host waits for that check before deciding on a rebuild.
-            if (drift_checked_) { // only after the gather schedule's prediction (predicts_drift)
+            if (drift_checked_) { // never in the all-free variant (step_with above)
                 if constexpr (!AllFree) for_each_index(Policy{}, n, drift);
             } else {
                 checked_into(drift, check(), &report->moved2);
