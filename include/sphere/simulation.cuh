@@ -363,7 +363,7 @@ public:
             kinds_.push_back(p.kind);
             if (p.kind == motion::prescribed || p.kind == motion::prescribed_horizontal) drive_ = true;
         }
-        all_free_ = std::all_of(kinds_.begin(), kinds_.end(), [](motion k) { return k == motion::free; });
+        all_free_ = every_particle_free();
         const std::size_t n = particles.size();
         std::vector<particle<Coord>>().swap(particles); // copied: its memory is not held through the first build
         walls_ = wall_set<Coord>::from_world(s.box);
@@ -667,7 +667,7 @@ public:
                 detail::fail("restore: particle ", i, " has motion kind ", unsigned(s.particles.kind[i]), ", at most ",
                              unsigned(last_motion), " is valid");
         for (std::size_t i = 0; i < size(); ++i) kinds_[i] = static_cast<motion>(s.particles.kind[i]);
-        all_free_ = std::all_of(kinds_.begin(), kinds_.end(), [](motion k) { return k == motion::free; });
+        all_free_ = every_particle_free();
         for (std::size_t i = 0; i < size(); ++i) check_material(i, s.particles.material[i], "restore: ");
         if (s.x_at_build.size() != size())
             detail::fail("restore: the state holds ", s.x_at_build.size(), " build positions for ", size(), " particles");
@@ -869,6 +869,12 @@ private:
             settings_.contact_forces ? step_with<External, false, true>() : step_with<External, false, false>();
     }
 
+    /// Whether every particle's motion (kinds_) is motion::free.
+    bool every_particle_free() const
+    {
+        return std::all_of(kinds_.begin(), kinds_.end(), [](motion k) { return k == motion::free; });
+    }
+
     /// One step with the switches of the settings: `Book` the energy audit, `Record` each
     /// contact's force. On the host's slab schedule, a simulation whose particles are all free
     /// and without external forces integrates them without loading their kinds
@@ -944,7 +950,7 @@ private:
             };
             if constexpr (!drifted) {
                 finish(check());
-            } else if (predicts_drift()) {
+            } else if (predicts_drift()) { // never in the all-free variant (slab schedule)
                 if constexpr (!AllFree) finish(detail::check_after_drift<Precision, Integrator, External>{drift, check()});
             } else {
                 finish(detail::no_check<Coord>{});
