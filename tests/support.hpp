@@ -5,7 +5,7 @@
 // where each test asserts.
 #include <sphere/dem.cuh>
 
-// The backend the physics tests run on: the host test binaries leave it unset (sphere::host);
+// The backend the physics tests run on: the host test binary leaves it unset (sphere::host);
 // the CUDA test binary (tests/cuda/tests.cu) compiles the same test sources with sphere::cuda.
 #ifndef SPHERE_TEST_POLICY
 #define SPHERE_TEST_POLICY sphere::host

@@ -18,6 +18,10 @@
 #include <random>
 #include <vector>
 
+// This file's tests and helpers in a namespace of their own: the test sources are compiled
+// several to a translation unit (tests/CMakeLists.txt).
+namespace test_analysis {
+
 namespace {
 
 using sphere::vec3;
@@ -488,3 +492,5 @@ TEMPLATE_TEST_CASE("Love-Weber counts the friction of wall contacts", "[analysis
     CHECK(t.s[2][0] == 0); // the branch vector has no x component
     CHECK(t.s[0][0] == 0);
 }
+
+} // namespace test_analysis

@@ -23,6 +23,10 @@
 #include <type_traits>
 #include <vector>
 
+// This file's tests and helpers in a namespace of their own: the test sources are compiled
+// several to a translation unit (tests/CMakeLists.txt).
+namespace test_bonds {
+
 namespace {
 
 using sphere_test::user_real;
@@ -522,3 +526,5 @@ TEMPLATE_TEST_CASE("bonds: add_bonds joins particles during a run", "[bonds]", f
     const auto x = sim.snapshot();
     CHECK(double(x.position(1).x - x.position(0).x) == Approx(rest).epsilon(0.01));
 }
+
+} // namespace test_bonds

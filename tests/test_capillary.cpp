@@ -16,6 +16,10 @@
 #include <type_traits>
 #include <vector>
 
+// This file's tests and helpers in a namespace of their own: the test sources are compiled
+// several to a translation unit (tests/CMakeLists.txt).
+namespace test_capillary {
+
 namespace {
 
 using sphere_test::user_real;
@@ -250,3 +254,5 @@ TEMPLATE_TEST_CASE("capillary: bridges on the Hertz-Mindlin law", "[capillary][h
     CHECK(c.last < (sphere_test::single_fields<TestType> ? 1e-3 : 1e-4) * c.ke0);
     CHECK(std::fabs(c.lost / bridge_work() - 1) < (std::is_same_v<TestType, float> ? 0.03 : 0.01));
 }
+
+} // namespace test_capillary

@@ -18,6 +18,10 @@
 #include <type_traits>
 #include <vector>
 
+// This file's tests and helpers in a namespace of their own: the test sources are compiled
+// several to a translation unit (tests/CMakeLists.txt).
+namespace test_collisions {
+
 namespace {
 
 using sphere::vec3;
@@ -895,3 +899,5 @@ TEMPLATE_TEST_CASE("damping ratios: every pair has the restitution its ratio giv
     REQUIRE_THROWS_WITH((test_sim<P>(s, {ball<Real>({0, 0, 0})})),
                         Catch::Contains("settings.contact.gamma_t = -1 (ratio to critical damping): must be non-negative"));
 }
+
+} // namespace test_collisions

@@ -28,6 +28,10 @@
 #include <random>
 #include <vector>
 
+// This file's tests and helpers in a namespace of their own: the test sources are compiled
+// several to a translation unit (tests/CMakeLists.txt).
+namespace test_coupling {
+
 namespace {
 
 using sphere::vec3;
@@ -473,3 +477,5 @@ TEMPLATE_TEST_CASE("hindered settling in a closed box: the fluid's flux through 
     CHECK(v_mean < -1e-3);
     CHECK(v_spread < 0.02 * std::abs(v_mean));
 }
+
+} // namespace test_coupling

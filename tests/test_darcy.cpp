@@ -24,6 +24,10 @@
 #include <string>
 #include <vector>
 
+// This file's tests and helpers in a namespace of their own: the test sources are compiled
+// several to a translation unit (tests/CMakeLists.txt).
+namespace test_darcy {
+
 namespace {
 
 constexpr double pi = 3.14159265358979323846;
@@ -352,3 +356,5 @@ TEMPLATE_TEST_CASE("Darcy and Navier-Stokes agree on a slow flow through a fixed
         CHECK(double(fields.velocity[c].z) == Approx(U / double(fields.porosity[c])).epsilon(sizeof(Real) == 8 ? 1e-8 : 1e-3));
     }
 }
+
+} // namespace test_darcy

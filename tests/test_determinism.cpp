@@ -20,6 +20,10 @@
 #include <utility>
 #include <vector>
 
+// This file's tests and helpers in a namespace of their own: the test sources are compiled
+// several to a translation unit (tests/CMakeLists.txt).
+namespace test_determinism {
+
 namespace {
 
 using sphere::vec3;
@@ -664,3 +668,5 @@ TEMPLATE_TEST_CASE("colliding particles whose partners come near and touch betwe
     CHECK(dx <= tol * 0.01); // of the radius
     CHECK(dv <= tol * v_scale);
 }
+
+} // namespace test_determinism

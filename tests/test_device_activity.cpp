@@ -26,6 +26,10 @@
 
 #include "support.hpp"
 
+// This file's tests and helpers in a namespace of their own: the test sources are compiled
+// several to a translation unit (tests/CMakeLists.txt).
+namespace test_device_activity {
+
 namespace {
 
 sphere::device_activity_counts since(const sphere::device_activity_counts& start)
@@ -329,3 +333,5 @@ TEST_CASE("device activity: a rebuild whose entries wrap the 32-bit offsets is a
     t.overflow = t.wrapped = 1;
     CHECK_THROWS_WITH(lists.settle(t), Catch::Contains("more than 4294967295 contact entries"));
 }
+
+} // namespace test_device_activity

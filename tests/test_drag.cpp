@@ -22,6 +22,10 @@
 #include <type_traits>
 #include <utility>
 
+// This file's tests and helpers in a namespace of their own: the test sources are compiled
+// several to a translation unit (tests/CMakeLists.txt).
+namespace test_drag {
+
 namespace {
 
 using sphere::vec3;
@@ -472,3 +476,5 @@ TEMPLATE_TEST_CASE("drag inputs are checked on the host with messages naming the
     CHECK_THROWS_WITH(drag::check_porosity(Real(1.25), "cell 7"), "sphere: cell 7: porosity phi = 1.25 is outside (0, 1]");
     CHECK_THROWS_WITH(drag::check_diameter(Real(-1)), "sphere: drag: particle diameter d = -1 m must be positive and finite");
 }
+
+} // namespace test_drag

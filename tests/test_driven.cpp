@@ -9,6 +9,10 @@
 #include <random>
 #include <vector>
 
+// This file's tests and helpers in a namespace of their own: the test sources are compiled
+// several to a translation unit (tests/CMakeLists.txt).
+namespace test_driven {
+
 namespace {
 
 using sphere_test::ball;
@@ -203,3 +207,5 @@ TEMPLATE_TEST_CASE("make_shear_cell fixes the floor and drives the top layer; re
     bad.particles.kind[2] = 9;
     CHECK_THROWS_WITH(sim.restore(bad), Catch::Contains("particle 2 has motion kind 9"));
 }
+
+} // namespace test_driven

@@ -18,6 +18,10 @@
 #include <type_traits>
 #include <vector>
 
+// This file's tests and helpers in a namespace of their own: the test sources are compiled
+// several to a translation unit (tests/CMakeLists.txt).
+namespace test_errors {
+
 using Catch::Contains;
 
 /// The expression throws a sphere::error (and nothing else), and its message matches.
@@ -712,3 +716,5 @@ TEMPLATE_TEST_CASE("the last gaps: a wall mode out of range, a state with short 
     REQUIRE_SPHERE_ERROR((sphere::inserter<Sim>(in, 0.0)),
                          Contains("insertion_settings: the region spans [0, inf] m on axis 2: its bounds must be finite"));
 }
+
+} // namespace test_errors

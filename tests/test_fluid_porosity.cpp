@@ -24,6 +24,10 @@
 #include <random>
 #include <vector>
 
+// This file's tests and helpers in a namespace of their own: the test sources are compiled
+// several to a translation unit (tests/CMakeLists.txt).
+namespace test_fluid_porosity {
+
 namespace {
 
 using sphere::vec3;
@@ -758,3 +762,5 @@ TEMPLATE_TEST_CASE("fluid grid and porosity estimator: errors name the bad value
     CHECK_THROWS_WITH(volume.update(big, Real(1)),
                       Catch::Contains("periodic axis x of length 1 m is shorter than twice half the cell width 0.25 m"));
 }
+
+} // namespace test_fluid_porosity

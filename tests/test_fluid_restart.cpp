@@ -36,6 +36,10 @@
 #include <variant>
 #include <vector>
 
+// This file's tests and helpers in a namespace of their own: the test sources are compiled
+// several to a translation unit (tests/CMakeLists.txt).
+namespace test_fluid_restart {
+
 namespace {
 
 using sphere_test::as_version;
@@ -655,3 +659,5 @@ TEMPLATE_TEST_CASE("make_coupling builds the coupling a setup names: the typed c
     CHECK_THROWS_WITH((sphere::make_coupling<Real, sphere::host>(no_permeability, grid, "test")),
                       Catch::Contains("permeability_prefactor = 0"));
 }
+
+} // namespace test_fluid_restart

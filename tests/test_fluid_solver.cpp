@@ -19,6 +19,10 @@
 #include <string>
 #include <vector>
 
+// This file's tests and helpers in a namespace of their own: the test sources are compiled
+// several to a translation unit (tests/CMakeLists.txt).
+namespace test_fluid_solver {
+
 namespace {
 
 using sphere::vec3;
@@ -339,3 +343,5 @@ TEST_CASE("Jacobi and conjugate gradients give the same flow", "[fluid]")
         for (std::size_t c = 0; c < vj.size(); ++c) REQUIRE(double(vc[c]) == Approx(double(vj[c])).margin(1e-12));
     }
 }
+
+} // namespace test_fluid_solver

@@ -22,6 +22,10 @@
 #include <cstddef>
 #include <vector>
 
+// This file's tests and helpers in a namespace of their own: the test sources are compiled
+// several to a translation unit (tests/CMakeLists.txt).
+namespace test_fluidisation {
+
 namespace {
 
 constexpr double pi = 3.14159265358979323846;
@@ -306,3 +310,5 @@ TEMPLATE_TEST_CASE("fluidisation driven by inflow: packed below U_mf, expanded a
     // less than half of what the first did (a plug rising at U - U_mf adds as much; measured 0.3-0.4).
     CHECK(fluidised.growth - fluidised.growth_half < 0.5 * fluidised.growth_half);
 }
+
+} // namespace test_fluidisation

@@ -16,6 +16,10 @@
 #include <type_traits>
 #include <vector>
 
+// This file's tests and helpers in a namespace of their own: the test sources are compiled
+// several to a translation unit (tests/CMakeLists.txt).
+namespace test_gas {
+
 using sphere::vec3;
 using sphere_test::ball;
 using sphere_test::box_settings;
@@ -219,3 +223,5 @@ TEMPLATE_TEST_CASE("D11 elastic gas conserves momentum and energy", "[gas][D11]"
     SECTION("semi-implicit Euler (default)") { check_d11<TestType, sphere::integrate::semi_implicit_euler>(); }
     SECTION("velocity Verlet") { check_d11<TestType, sphere::integrate::velocity_verlet>(); }
 }
+
+} // namespace test_gas

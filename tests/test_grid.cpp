@@ -26,6 +26,10 @@
 #include <utility>
 #include <vector>
 
+// This file's tests and helpers in a namespace of their own: the test sources are compiled
+// several to a translation unit (tests/CMakeLists.txt).
+namespace test_grid {
+
 namespace {
 
 using sphere::boundary;
@@ -823,3 +827,5 @@ TEMPLATE_TEST_CASE("every cell's start is the number of particles in lower cells
         if (k > 0) CHECK(g.cell_of(v.sorted_x[k - 1].xyz()) <= g.cell_of(v.sorted_x[k].xyz()));
     }
 }
+
+} // namespace test_grid

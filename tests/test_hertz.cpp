@@ -17,6 +17,10 @@
 #include <string>
 #include <vector>
 
+// This file's tests and helpers in a namespace of their own: the test sources are compiled
+// several to a translation unit (tests/CMakeLists.txt).
+namespace test_hertz {
+
 namespace {
 
 using sphere::vec3;
@@ -373,3 +377,5 @@ TEMPLATE_TEST_CASE("Hertz: a checkpoint names its law and restarts bit for bit",
                                       "visco_frictional>") &&
                           Catch::Contains("restart it with the same law"));
 }
+
+} // namespace test_hertz

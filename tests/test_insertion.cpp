@@ -15,6 +15,10 @@
 #include <string>
 #include <vector>
 
+// This file's tests and helpers in a namespace of their own: the test sources are compiled
+// several to a translation unit (tests/CMakeLists.txt).
+namespace test_insertion {
+
 namespace {
 
 template <class Real>
@@ -256,3 +260,5 @@ TEMPLATE_TEST_CASE("inserter: log-normal radii within their range", "[insertion]
     CHECK_THROWS_WITH(sphere::inserter<host_sim<Real>>(in_s, 0.0),
                       Catch::Contains("insertion_settings.radius_mean = ") && Catch::Contains("lies outside"));
 }
+
+} // namespace test_insertion

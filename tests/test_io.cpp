@@ -38,6 +38,10 @@
 #include <type_traits>
 #include <vector>
 
+// This file's tests and helpers in a namespace of their own: the test sources are compiled
+// several to a translation unit (tests/CMakeLists.txt).
+namespace test_io {
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -854,3 +858,5 @@ TEMPLATE_TEST_CASE("vtu frames and the pvd collection hold every particle and fi
     REQUIRE_THROWS_WITH(sphere::vtk_writer(folder, "a/b"), Catch::Contains("prefix 'a/b'"));
     REQUIRE_THROWS_WITH(sphere::vtk_writer(folder, "p", 0), Catch::Contains("output interval 0"));
 }
+
+} // namespace test_io

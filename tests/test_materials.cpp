@@ -18,6 +18,10 @@
 #include <string>
 #include <vector>
 
+// This file's tests and helpers in a namespace of their own: the test sources are compiled
+// several to a translation unit (tests/CMakeLists.txt).
+namespace test_materials {
+
 namespace {
 
 using sphere_test::user_real;
@@ -265,3 +269,5 @@ TEMPLATE_TEST_CASE("materials: bad material indices and parameters are refused b
         },
         "settings.contact.material[0].tension and settings.contact.material[1].tension differ");
 }
+
+} // namespace test_materials

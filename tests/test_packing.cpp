@@ -20,6 +20,10 @@
 #include <random>
 #include <vector>
 
+// This file's tests and helpers in a namespace of their own: the test sources are compiled
+// several to a translation unit (tests/CMakeLists.txt).
+namespace test_packing {
+
 namespace {
 
 using sphere::vec3;
@@ -443,3 +447,5 @@ TEST_CASE("D13: packing fraction after pouring, friction 0.3", "[packing][deposi
     CHECK(p.core_fraction >= 0.575);
     CHECK(p.core_fraction <= 0.605);
 }
+
+} // namespace test_packing

@@ -36,6 +36,10 @@
 #include <string>
 #include <vector>
 
+// This file's tests and helpers in a namespace of their own: the test sources are compiled
+// several to a translation unit (tests/CMakeLists.txt).
+namespace test_poisson {
+
 namespace {
 
 using sphere::poisson_boundaries;
@@ -870,3 +874,5 @@ TEMPLATE_TEST_CASE("MG-PCG's levels coarsen even counts by halves and odd layer 
     const std::vector<std::vector<unsigned>> neumann_levels = {{12, 10, 16}, {6, 5, 8}, {3, 5, 4}, {3, 5, 2}};
     CHECK(solver.level_sizes() == neumann_levels);
 }
+
+} // namespace test_poisson

@@ -9,6 +9,10 @@
 #include <cmath>
 #include <vector>
 
+// This file's tests and helpers in a namespace of their own: the test sources are compiled
+// several to a translation unit (tests/CMakeLists.txt).
+namespace test_precision {
+
 using sphere::vec3;
 using sphere_test::user_real;
 
@@ -159,3 +163,5 @@ TEST_CASE("mixed refuses values that float cannot hold, naming them", "[precisio
     CHECK_THROWS_WITH(sphere::simulation<double>(t, ps),
                       Catch::Contains("s is below 1e-15 s") && !Catch::Contains("float"));
 }
+
+} // namespace test_precision

@@ -26,6 +26,10 @@
 #include <string>
 #include <vector>
 
+// This file's tests and helpers in a namespace of their own: the test sources are compiled
+// several to a translation unit (tests/CMakeLists.txt).
+namespace test_render {
+
 namespace {
 
 using sphere::rgb;
@@ -430,3 +434,5 @@ TEST_CASE("bad input to the renderer raises clear errors", "[render][errors]")
                         Catch::Contains("cannot write '" + folder / "zero.png" + "': the image is 0 x 0 pixels"));
     REQUIRE(!std::filesystem::exists(folder / "zero.png"));
 }
+
+} // namespace test_render

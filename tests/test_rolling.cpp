@@ -19,6 +19,10 @@
 #include <type_traits>
 #include <vector>
 
+// This file's tests and helpers in a namespace of their own: the test sources are compiled
+// several to a translation unit (tests/CMakeLists.txt).
+namespace test_rolling {
+
 namespace {
 
 using sphere_test::user_real;
@@ -356,3 +360,5 @@ TEMPLATE_TEST_CASE("rolling: bad parameters are refused by name", "[rolling][err
     const double turning = std::sqrt(0.2 * mass * radius * radius / 100);
     CHECK(std::fabs(double(rolling_sim<Real>(stiff, ps).dt()) / (0.075 * turning) - 1) < 1e-5);
 }
+
+} // namespace test_rolling

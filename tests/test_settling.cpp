@@ -23,6 +23,10 @@
 #include <random>
 #include <vector>
 
+// This file's tests and helpers in a namespace of their own: the test sources are compiled
+// several to a translation unit (tests/CMakeLists.txt).
+namespace test_settling {
+
 namespace {
 
 constexpr double r0 = 1e-3;      // mean radius (m)
@@ -146,3 +150,5 @@ TEMPLATE_TEST_CASE("a polydisperse bed settles under gravity to rest with a clos
     CHECK(r.dissipated > 0.9 * r.released);
     CHECK(r.max_budget < 0.01 * r.released);
 }
+
+} // namespace test_settling

@@ -10,6 +10,10 @@
 #include <cmath>
 #include <vector>
 
+// This file's tests and helpers in a namespace of their own: the test sources are compiled
+// several to a translation unit (tests/CMakeLists.txt).
+namespace test_shear {
+
 namespace {
 
 /// Everything the window balance needs, at one moment.
@@ -123,3 +127,5 @@ TEST_CASE("D15: a shear cell balances boundary work against energy change and di
     // The wall kept the normal stress within 5% (time-averaged) over the window.
     CHECK(std::abs(sigma_sum / double(samples) / sigma0 - 1) < 0.05);
 }
+
+} // namespace test_shear

@@ -18,6 +18,10 @@
 #include <type_traits>
 #include <vector>
 
+// This file's tests and helpers in a namespace of their own: the test sources are compiled
+// several to a translation unit (tests/CMakeLists.txt).
+namespace test_tangential {
+
 using sphere::vec3;
 using sphere_test::ball;
 using sphere_test::box_settings;
@@ -640,3 +644,5 @@ TEMPLATE_TEST_CASE("D9 rigid rotation of a stretched contact and a new contact",
         CHECK(ft_max < zero_tol);
     }
 }
+
+} // namespace test_tangential

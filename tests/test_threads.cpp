@@ -12,6 +12,10 @@
 #include <string>
 #include <vector>
 
+// This file's tests and helpers in a namespace of their own: the test sources are compiled
+// several to a translation unit (tests/CMakeLists.txt).
+namespace test_threads {
+
 namespace {
 
 using sphere::team_choice;
@@ -164,3 +168,5 @@ TEST_CASE("thread_governor obeys OMP_NUM_THREADS and SPHERE_ADAPT_THREADS=0", "[
     CHECK(sphere::host_team_limit() == 0); // lifted when the governor goes
     if (omp) setenv("OMP_NUM_THREADS", saved.c_str(), 1);
 }
+
+} // namespace test_threads

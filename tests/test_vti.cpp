@@ -25,6 +25,10 @@
 
 #include <unistd.h>
 
+// This file's tests and helpers in a namespace of their own: the test sources are compiled
+// several to a translation unit (tests/CMakeLists.txt).
+namespace test_vti {
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -313,3 +317,5 @@ TEMPLATE_TEST_CASE("vti: a coupled fluid also writes the porosity rate", "[io][v
     CHECK(read_bytes(dir / "fluid_000000.vti") == sphere::vti_text(sphere::fluid_fields(coupled), sim.time()));
     CHECK(fs::exists(dir / "fluid.pvd"));
 }
+
+} // namespace test_vti

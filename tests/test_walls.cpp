@@ -10,6 +10,10 @@
 #include <random>
 #include <vector>
 
+// This file's tests and helpers in a namespace of their own: the test sources are compiled
+// several to a translation unit (tests/CMakeLists.txt).
+namespace test_walls {
+
 namespace {
 
 using sphere_test::set_p;
@@ -300,3 +304,5 @@ TEMPLATE_TEST_CASE("between two walls a sphere creeps at m g / (2 gamma_wt) unde
     CHECK(v_creep == Approx(-creep).epsilon(0.01));
     CHECK(std::fabs(v_rest) < 1e-3 * creep);
 }
+
+} // namespace test_walls

@@ -1,7 +1,7 @@
 // The CUDA test binary (sphere_cuda_tests, tests/CMakeLists.txt): physics tests written once for
 // every backend, compiled here by nvcc with sphere::cuda as the policy of the simulations they
 // create (sphere_test::policy, tests/support.hpp), and the comparison of the two backends.
-// The host test binaries compile the same sources with sphere::host.
+// The host test binary (sphere_tests) compiles the same sources with sphere::host.
 //
 // One translation unit, so that nvcc compiles the kernels of each simulation type once. The
 // sources are chosen to keep its compile time within a few minutes for one architecture (CI):
