@@ -131,6 +131,26 @@ counts count(const Sim& sim)
     return {2.0 * double(pairs) / double(n), walls, ke / (double(n) * mgd)};
 }
 
+/// The particles of tile[0] x tile[1] copies of the periodic bed, in the file's order or
+/// shuffled (the order of the copies' indices is freed on return: it is not the simulation's).
+template <class Real>
+std::vector<sphere::particle<Real>> bed_particles(const options& o, const bed_file& b)
+{
+    const std::size_t per_tile = b.x.size(), tx = o.tile[0], ty = o.tile[1];
+    std::vector<std::size_t> order(per_tile * tx * ty);
+    for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+    if (o.order == "shuffled") std::shuffle(order.begin(), order.end(), std::mt19937(12345));
+    std::vector<sphere::particle<Real>> ps(order.size());
+    for (std::size_t k = 0; k < order.size(); ++k) {
+        const std::size_t i = order[k] % per_tile, t = order[k] / per_tile;
+        const double dx = double(t % tx) * b.length, dy = double(t / tx) * b.length;
+        ps[k].position = {Real(b.x[i] + dx), Real(b.y[i] + dy), Real(b.z[i])};
+        ps[k].radius = Real(b.r[i]);
+        ps[k].density = Real(density);
+    }
+    return ps;
+}
+
 template <class Precision>
 int run(const options& o, const bed_file& b)
 {
@@ -156,18 +176,7 @@ int run(const options& o, const bed_file& b)
     s.accumulated_displacement = false; // nor the displacements
 
     const double rss_program = status_bytes("VmRSS"); // the program and the input file, before any particle
-    const std::size_t per_tile = b.x.size();
-    std::vector<std::size_t> order(per_tile * tx * ty);
-    for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
-    if (o.order == "shuffled") std::shuffle(order.begin(), order.end(), std::mt19937(12345));
-    std::vector<particle<Real>> ps(order.size());
-    for (std::size_t k = 0; k < order.size(); ++k) {
-        const std::size_t i = order[k] % per_tile, t = order[k] / per_tile;
-        const double dx = double(t % tx) * b.length, dy = double(t / tx) * b.length;
-        ps[k].position = {Real(b.x[i] + dx), Real(b.y[i] + dy), Real(b.z[i])};
-        ps[k].radius = Real(b.r[i]);
-        ps[k].density = Real(density);
-    }
+    std::vector<particle<Real>> ps = bed_particles<Real>(o, b);
 
     using law = contact::linear<tangential::elastic_viscous_frictional, tangential::elastic_viscous_frictional>;
     simulation<Precision, policy, law, integrate::velocity_verlet> sim(s, std::move(ps)); // no second copy
