@@ -18,7 +18,7 @@
 
 #include <omp.h>
 
-// The direct reference solve needs Eigen 3 (tests/CMakeLists.txt links test_poisson to
+// The direct reference solve needs Eigen 3 (tests/CMakeLists.txt links the test executable to
 // Eigen3::Eigen). Without it, one test case fails and says so, and the rest still runs.
 #if __has_include(<Eigen/Sparse>)
 #include <Eigen/Sparse>
