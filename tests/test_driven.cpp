@@ -175,7 +175,7 @@ TEMPLATE_TEST_CASE("shearing a small sample under a stress wall closes the energ
     CHECK(sim.walls().face[5].position < 6 * double(d));
 }
 
-TEMPLATE_TEST_CASE("make_shear_cell fixes the floor and drives the top layer; restore takes the new kinds",
+TEMPLATE_TEST_CASE("make_shear_cell fixes the floor and drives the top layer, and restore takes the new kinds",
                    "[driven][layers]", float, double)
 {
     using Real = TestType;

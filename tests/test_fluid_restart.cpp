@@ -320,7 +320,7 @@ TEMPLATE_TEST_CASE("a navier_stokes on its own restores bit-identically", "[flui
     CHECK_FALSE(same_bits(a.face_velocity(2), c.face_velocity(2)));
 }
 
-TEMPLATE_TEST_CASE("checkpoints without a fluid section still load; a coupled restart needs one",
+TEMPLATE_TEST_CASE("checkpoints without a fluid section still load, and a coupled restart needs one",
                    "[fluid][restart][checkpoint]", float, double)
 {
     // Version 7 is version 8 without the accumulated displacement at the end of the payload (a
