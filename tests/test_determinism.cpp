@@ -643,6 +643,7 @@ TEMPLATE_TEST_CASE("colliding particles whose partners come near and touch betwe
         s.pair_summation = how;
         sphere::simulation<P> sim(s, setup.second);
         sim.run(steps);
+        CHECK(sim.far_openings() > 1); // the far rows got histories in more than one list's life
         return std::make_pair(record_of(sim), sim.near_walks());
     };
     const std::size_t steps = 60;

@@ -828,4 +828,58 @@ TEMPLATE_TEST_CASE("every cell's start is the number of particles in lower cells
     }
 }
 
+TEMPLATE_TEST_CASE("contact lists give histories to their near rows only, until a step must walk the far rows",
+                   "[grid][contacts]", float, double)
+{
+    using Real = TestType;
+    // Three spheres of radius 1 mm in a row on the floor of a box with walls: a touches b; c
+    // lies 0.5 skin beyond b, within the skin but not within the near skin (an eighth of it),
+    // so the lists hold a near pair {a, b}, the three floor contacts and a far pair {b, c}. A resting bed never walks its far rows: their histories take no memory
+    // (docs/architecture.md, *Near partners*) until a step must walk them.
+    const Real r = Real(0.001), skin = Real(0.0004);
+    sphere::world<Real> box;
+    box.lo = {0, 0, 0};
+    box.hi = {Real(0.01), Real(0.01), Real(0.01)};
+    std::vector<sphere::vec4<Real>> x{{Real(0.003), Real(0.005), r, r},
+                                      {Real(0.003) + 2 * r - Real(1e-6), Real(0.005), r, r},
+                                      {Real(0.003) + 4 * r - Real(1e-6) + skin / 2, Real(0.005), r, r}};
+    std::vector<unsigned> user{0, 1, 2};
+    sphere::particle_view<Real> p{};
+    p.n = x.size();
+    p.x = x.data();
+    p.user = user.data();
+    sphere::neighbor_grid<Real, sphere::host> grid(sphere::grid_geometry<Real>::make(box, 2 * r + skin, Real(0)));
+    sphere::execution_context<sphere::host> context;
+    sphere::contact_lists<Real, sphere::host> lists(x.size(), false);
+    const auto rebuild = [&] {
+        grid.build(context, p);
+        sphere::list_totals t;
+        do lists.rebuild(context, grid.view(), sphere::wall_set<Real>::from_world(box), skin, skin / 8, true, &t);
+        while (!lists.settle(t, false));
+    };
+    rebuild();
+    CHECK(lists.entries() == 5);
+    CHECK(lists.near_entries() == 4); // {a, b} and the floor's
+    CHECK(lists.history_capacity() == 4);
+    CHECK_FALSE(lists.far_histories());
+    const unsigned far = lists.view().offset[x.size()]; // the first far row's entry
+    CHECK_FALSE(lists.view().has_history(far));
+    const sphere::contact_table<Real> table = lists.table(user);
+    const std::size_t bc = table.find(1, 2);
+    REQUIRE(bc != ~std::size_t(0)); // the far pair is listed, without a history
+    CHECK(sphere::norm2(table.history[bc].xyz()) == 0);
+    CHECK(table.history[bc].w == 0);
+
+    CHECK(lists.open_far_rows());
+    CHECK(lists.far_histories());
+    CHECK(lists.history_capacity() >= 5);
+    CHECK_FALSE(lists.open_far_rows()); // once per lists
+    CHECK(lists.view().has_history(far));
+    CHECK_FALSE(lists.view().history.has(far)); // opened clear
+
+    rebuild(); // new lists: their far rows have no histories again; the arrays keep their size
+    CHECK_FALSE(lists.far_histories());
+    CHECK(lists.history_capacity() >= 5);
+}
+
 } // namespace test_grid

@@ -149,8 +149,7 @@ struct row_overlap {
         const vec4<Coord> xi = p.x[i];
         const double coincident = deepest_overlap::coincident;
         deepest_overlap out{0, ~0u, ~0u};
-        for (unsigned e = c.offset[r]; e < c.offset[r + 1] && c.partner[e] < wall_partner_base; ++e) {
-            const unsigned j = c.partner[e];
+        const auto pair = [&](unsigned j) {
             const vec4<Coord> xj = p.x[j];
             const vec3<Coord> d = box.nearest_image_inside(xi.xyz() - xj.xyz());
             const double dist = std::sqrt(double(norm2(d))), smaller = double(xi.w < xj.w ? xi.w : xj.w);
@@ -158,7 +157,9 @@ struct row_overlap {
             const unsigned ui = p.user[i], uj = p.user[j];
             const deepest_overlap here{fraction, ui < uj ? ui : uj, ui < uj ? uj : ui};
             if (here.before(out)) out = here;
-        }
+        };
+        for (unsigned e = c.offset[r]; e < c.offset[r + 1] && c.partner[e] < wall_partner_base; ++e) pair(c.partner[e]);
+        for (unsigned e = c.far_begin(r); e < c.far_end(r); ++e) pair(c.partner[e]);
         return out;
     }
 };
@@ -478,11 +479,15 @@ public:
     std::size_t steps() const { return steps_; }
     /// How many times the grid and contact lists were built (including at setup).
     std::size_t rebuilds() const { return rebuilds_; }
-    /// How many of this simulation object's steps summed the pair contacts walking only each
-    /// row's near partners (while no particle has moved half the near skin since the last
+    /// How many of this simulation object's steps summed the pair contacts walking only the
+    /// lists' near rows (while no particle has moved half the near skin since the last
     /// rebuild, and on the gather schedule not at a step that rebuilds nor at the first after a
     /// restore: docs/architecture.md, *Near partners*). Not in the state.
     std::size_t near_walks() const { return near_walks_; }
+    /// How many lists (from one rebuild to the next) gave their far partners histories, for a
+    /// step that walked them because some particle had moved a sixteenth of the skin
+    /// (docs/architecture.md, *Near partners*); the first time, an allocation. Not in the state.
+    std::size_t far_openings() const { return far_openings_; }
     /// The deepest overlap the particles started with, as a fraction of the smaller radius (of
     /// the particle's at a wall); settings.max_initial_overlap bounds it.
     double initial_overlap() const { return initial_overlap_; }
@@ -722,7 +727,9 @@ public:
         interaction_.lists_changed();
         wall_launch_ = lists_.wall_particles();
         detail::step_report<Coord> fresh{};
-        fresh.lists = {0, unsigned(lists_.entries()), unsigned(wall_launch_), 0, 0};
+        fresh.lists.entries = unsigned(lists_.entries());
+        fresh.lists.near_entries = unsigned(lists_.near_entries());
+        fresh.lists.wall_particles = unsigned(wall_launch_);
         report_.assign(std::vector<detail::step_report<Coord>>{fresh});
         std::vector<vec4<Coord>> slots(size());
         for (std::size_t k = 0; k < size(); ++k) slots[k] = s.x_at_build[storage[k]];
@@ -934,6 +941,7 @@ private:
         // walk the near ones alone (their histories are clear: docs/architecture.md).
         const bool apart = rebuild || near_holds();
         const bool near_only = apart && (rebuild || far_clear_);
+        if (!near_only) open_far_rows();
         detail::step_report<Coord> done{};
         do {
             if (rebuild) rebuild_lists(&report->lists);
@@ -1011,7 +1019,7 @@ private:
                 return;
             }
         } else {
-            interaction_.template sum_pairs<Book, Record>(context_, pair_contact(), lists_, summation_, true);
+            interaction_.template sum_pairs<Book, Record>(context_, pair_contact(), lists_, summation_, true, near_only);
         }
         if constexpr (!SlabsOnly) {
             transform_reduce_into(context_, wall_launch_, walls, detail::wall_loads{{0, 0, 0, 0, 0, 0}}, plus_op{},
@@ -1045,7 +1053,9 @@ private:
     template <bool Record>
     void initial_forces()
     {
-        interaction_.template sum_pairs<false, Record>(context_, pair_contact(), lists_, summation_, false);
+        const bool near_only = near_holds() && far_clear_;
+        if (!near_only) open_far_rows();
+        interaction_.template sum_pairs<false, Record>(context_, pair_contact(), lists_, summation_, false, near_only);
         transform_reduce_into(context_, wall_launch_, wall_contacts<false, Record>(false),
                               detail::wall_loads{{0, 0, 0, 0, 0, 0}}, plus_op{}, &report_.data()->loads);
     }
@@ -1098,9 +1108,15 @@ private:
         needs_rebuild_ = needs_rebuild_ || rebuild;
     }
 
-    /// The near skin (m): the lists put first in each row the partners within r_i + r_j + near
-    /// skin (+ the law's range) at the rebuild, an eighth of the skin (docs/architecture.md,
-    /// *Near partners*).
+    /// Gives the lists' far rows histories for a step that walks them (until the next rebuild).
+    void open_far_rows()
+    {
+        if (lists_.open_far_rows()) ++far_openings_;
+    }
+
+    /// The near skin (m): the lists' near rows hold the partners within r_i + r_j + near skin
+    /// (+ the law's range) at the rebuild, an eighth of the skin (docs/architecture.md, *Near
+    /// partners*).
     Coord near_skin() const { return settings_.skin / 8; }
 
     /// Whether the other partners of the lists are still apart: no particle has moved a half
@@ -1369,6 +1385,7 @@ private:
     double moved_ = 0;           ///< the largest displacement since the last rebuild (m), by the last particle check
     bool far_clear_ = true;      ///< the lists' other partners (not near) have no history
     std::size_t near_walks_ = 0; ///< near_walks()
+    std::size_t far_openings_ = 0; ///< far_openings()
     std::vector<motion> kinds_; ///< host copy of each particle's motion (it never changes)
     bool all_free_ = false;     ///< every particle's motion is motion::free
     std::vector<std::pair<std::size_t, observer>> observers_;

@@ -7,14 +7,17 @@
 /// after layer along its slow axis (grid/geometry.cuh), so each layer is a range of ranks. A
 /// pair {a, b} with |x_a - x_b| < r_a + r_b + skin is owned by one of the two: the one whose
 /// layer comes first (b in the next layer, cyclically on a periodic axis), or, in the same
-/// layer, the one of lower rank. The row of rank r lists the partners it owns: first those
-/// within r_a + r_b + near skin at the rebuild (its *near* partners), then the others, each
-/// group by partner rank, then every wall face within r + skin (by face). While no particle
-/// has moved more than half the near skin since the rebuild, the others cannot touch, and the
-/// pair sums walk the near partners alone (docs/architecture.md, *Near partners*).
-/// Each entry holds the contact's history (tangential displacement as seen by the owner,
-/// sliding flag) and, when recorded, the force of the last step. The lists hold what they
-/// find: no capacity to set.
+/// layer, the one of lower rank. Rank r has two rows of the partners it owns: its *near* row,
+/// the partners within r_a + r_b + near skin at the rebuild (by partner rank), then every wall
+/// face within r + skin (by face); and its *far* row, the other partners (by partner rank).
+/// The near rows of all ranks come first in the arrays, the far rows after them. While no
+/// particle has moved more than half the near skin since the rebuild, the far partners cannot
+/// touch, and the pair sums walk the near rows alone (docs/architecture.md, *Near partners*).
+/// Each entry of a near row holds the contact's history (tangential displacement as seen by
+/// the owner, sliding flag) and, when recorded, the force of the last step; the far rows'
+/// entries have them only once a step must walk them (contact_lists::open_far_rows): a
+/// resting bed never stores the histories of the pairs that cannot touch. The lists hold what
+/// they find: no capacity to set.
 ///
 /// Ranks and ownership depend on the positions at the rebuild and the user indices alone, so
 /// the interaction, which follows them (contact/interact.cuh), gives the same bits whether or
@@ -51,14 +54,15 @@ inline constexpr unsigned wall_partner_base = 0xFFFFFFF0u;
 inline constexpr unsigned no_rank = 0xFFFFFFFFu;
 
 /// What a rebuild found, in the policy's memory (read back with the step's report): the
-/// entries whose history it carried over, the entries of the new lists, the particles with
-/// wall entries, and whether the first two exceeded the capacities the lists had. After an
-/// overflow the new lists are empty and contact_lists::settle grows them for the rebuild to
-/// run again. `wrapped`: the entries exceeded what 32-bit offsets hold (an overflow too,
-/// which settle reports as an error).
+/// entries whose history it carried over, the entries of the new lists and of their near rows,
+/// the particles with wall entries, and whether the first three exceeded the capacities the
+/// lists had. After an overflow the new lists are empty and contact_lists::settle grows them
+/// for the rebuild to run again. `wrapped`: the entries exceeded what 32-bit offsets hold (an
+/// overflow too, which settle reports as an error).
 struct list_totals {
     unsigned kept = 0;
     unsigned entries = 0;
+    unsigned near_entries = 0;
     unsigned wall_particles = 0;
     unsigned overflow = 0;
     unsigned wrapped = 0;
@@ -68,16 +72,24 @@ struct list_totals {
 template <class Real>
 struct contact_view {
     std::size_t n;                ///< particles
-    const unsigned* offset;       ///< entries of rank r: [offset[r], offset[r + 1])
+    const unsigned* offset;       ///< 2n + 1 values: near row of rank r [offset[r], offset[r + 1]), far row
+                                  ///< [offset[n + r], offset[n + r + 1])
     const unsigned* partner;      ///< storage slot of the partner, or wall_partner_base + f (walls last)
     history_view<Real> history;   ///< as seen by the owner (contact/history.cuh)
     vec4<Real>* force;            ///< f_t on the owner (N) in xyz, f_n . n (N) in w; null when not recorded
     const unsigned* slot_of_rank; ///< storage slot of each rank; null when they coincide (settings.reorder)
     const unsigned* rank_of_slot; ///< the inverse; null when they coincide
-    const unsigned* near_end;     ///< rank r's near partners: [offset[r], near_end[r])
+    bool far_history;             ///< the far rows' entries have histories (and forces) too
 
     SPHERE_HDI std::size_t slot(std::size_t r) const { return slot_of_rank ? slot_of_rank[r] : r; }
     SPHERE_HDI std::size_t rank(std::size_t s) const { return rank_of_slot ? rank_of_slot[s] : s; }
+    SPHERE_HDI unsigned far_begin(std::size_t r) const { return offset[n + r]; }
+    SPHERE_HDI unsigned far_end(std::size_t r) const { return offset[n + r + 1]; }
+    /// Entries in all rows.
+    SPHERE_HDI unsigned entries() const { return offset[2 * n]; }
+    /// Whether entry e has a history (and a recorded force): every near row's entry does, a
+    /// far row's only with far_history.
+    SPHERE_HDI bool has_history(std::size_t e) const { return far_history || e < offset[n]; }
 };
 
 /// A host copy of the contact lists in user order, each pair from both sides: entries of
@@ -114,8 +126,8 @@ struct contact_table {
 
 namespace detail {
 /// Whether particles at xi and xj (centre in xyz, radius in w) lie within r_i + r_j + skin of
-/// each other (nearest image): listed partners with the lists' skin (neighbour_scan), near
-/// partners with the near skin (fill_entries, contact_lists::restore).
+/// each other (nearest image): listed partners with the lists' skin, near partners with the
+/// near skin (neighbour_scan, contact_lists::restore).
 template <class Real>
 SPHERE_HDI bool within_skin(const world<Real>& box, const vec4<Real>& xi, const vec4<Real>& xj, Real skin)
 {
@@ -124,14 +136,15 @@ SPHERE_HDI bool within_skin(const world<Real>& box, const vec4<Real>& xi, const 
 }
 
 /// Scans the cells around the particle at rank k and visits the partners it owns within reach
-/// (`pair(q)` with the partner's rank q) and then every active wall within r + skin
-/// (`wall(f)`). Owned partners lie in k's own layer at a higher rank or in the next layer,
-/// so only those two layers are scanned.
+/// (`pair(q, near)` with the partner's rank q, and whether it lies within the near skin) and
+/// then every active wall within r + skin (`wall(f)`). Owned partners lie in k's own layer at
+/// a higher rank or in the next layer, so only those two layers are scanned.
 template <class Real>
 struct neighbour_scan {
     grid_view<Real> grid;
     wall_set<Real> walls;
     Real skin;
+    Real near_skin;
 
     template <class Visit>
     SPHERE_HD void operator()(std::size_t k, Visit& visit) const
@@ -201,17 +214,20 @@ private:
         unsigned q = grid.cell_start[first_cell];
         if (q < above) q = static_cast<unsigned>(above < end ? above : end);
         for (; q < end; ++q) {
-            if (within_skin(grid.geometry.box, xi, grid.sorted_x[q], skin)) visit.pair(q);
+            const vec4<Real> xq = grid.sorted_x[q];
+            if (within_skin(grid.geometry.box, xi, xq, skin))
+                visit.pair(q, within_skin(grid.geometry.box, xi, xq, near_skin));
         }
     }
 };
 
 struct count_visit {
-    unsigned found = 0;
-    SPHERE_HD void pair(unsigned) { ++found; }
-    SPHERE_HD void wall(int) { ++found; }
+    unsigned near = 0, far = 0;
+    SPHERE_HD void pair(unsigned, bool is_near) { ++(is_near ? near : far); }
+    SPHERE_HD void wall(int) { ++near; }
 };
 
+/// The lengths of rank k's near row (count[k]) and far row (count[n + k]).
 template <class Real>
 struct count_entries {
     neighbour_scan<Real> scan;
@@ -220,17 +236,35 @@ struct count_entries {
     {
         count_visit v;
         scan(k, v);
-        count[k] = v.found;
+        count[k] = v.near;
+        count[scan.grid.n + k] = v.far;
     }
 };
 
-/// Writes partner ranks (sort keys) and wall codes in visit order.
+/// Writes partner ranks (sort keys) in visit order, near ones and walls (which come after
+/// every partner) into the near row, the others into the far row.
 struct fill_visit {
-    unsigned* key;
-    unsigned found = 0;
-    SPHERE_HD void pair(unsigned q) { key[found++] = q; }
-    SPHERE_HD void wall(int f) { key[found++] = wall_partner_base + unsigned(f); }
+    unsigned* near_key;
+    unsigned* far_key;
+    unsigned near = 0, far = 0;
+    SPHERE_HD void pair(unsigned q, bool is_near)
+    {
+        if (is_near) near_key[near++] = q;
+        else far_key[far++] = q;
+    }
+    SPHERE_HD void wall(int f) { near_key[near++] = wall_partner_base + unsigned(f); }
 };
+
+/// Sorts the first n keys ascending (insertion sort: rows are short).
+SPHERE_HDI void sort_row(unsigned* key, unsigned n)
+{
+    for (unsigned a = 1; a < n; ++a) {
+        const unsigned q = key[a];
+        unsigned b = a;
+        for (; b > 0 && key[b - 1] > q; --b) key[b] = key[b - 1];
+        key[b] = q;
+    }
+}
 
 /// The histories carried over from the old lists (contact_lists' kept entries): rows by the
 /// particles' old slots, partners as old slots or wall codes.
@@ -253,17 +287,15 @@ struct old_lists {
     }
 };
 
-/// Fills the new row of rank k: partners by rank (stored as slots: the rank itself once the
-/// particles are permuted into rank order, the grid's old slot with `keep_order`), the near
-/// partners first, walls last, and carries over the history each near contact had in the old
-/// lists. The other partners start without one: they do not touch now, so the next pair sums
-/// would clear it.
+/// Fills the new rows of rank k: partners by rank (stored as slots: the rank itself once the
+/// particles are permuted into rank order, the grid's old slot with `keep_order`), walls last
+/// in the near row, and carries over the history each near contact had in the old lists. The
+/// far partners have no history: they do not touch now (a contact that touched lies within
+/// the near skin), and their rows have histories only once a step walks them.
 template <class Coord, class Real>
 struct fill_entries {
     neighbour_scan<Coord> scan;
-    Coord near_skin;
     const unsigned* offset;
-    unsigned* near_end;
     unsigned* partner;
     history_view<Real> history;
     old_lists<Real> old;
@@ -273,30 +305,19 @@ struct fill_entries {
     SPHERE_HD void operator()(std::size_t k) const
     {
         if (totals->overflow) return;
-        const unsigned begin = offset[k], n = offset[k + 1] - begin;
+        const std::size_t n = scan.grid.n;
+        const unsigned begin = offset[k], far_begin = offset[n + k];
         unsigned* p = partner + begin;
-        fill_visit v{p};
+        unsigned* q = partner + far_begin;
+        fill_visit v{p, q};
         scan(k, v);
         unsigned pairs = 0;
-        while (pairs < n && p[pairs] < wall_partner_base) ++pairs;
-        for (unsigned a = 1; a < pairs; ++a) { // insertion sort by rank: rows are short
-            const unsigned q = p[a];
-            unsigned b = a;
-            for (; b > 0 && p[b - 1] > q; --b) p[b] = p[b - 1];
-            p[b] = q;
-        }
-        const vec4<Coord> xi = scan.grid.sorted_x[k];
-        unsigned near = 0;
-        for (unsigned a = 0; a < pairs; ++a) { // near partners to the front, both groups in order
-            const unsigned q = p[a];
-            if (!within_skin(scan.grid.geometry.box, xi, scan.grid.sorted_x[q], near_skin)) continue;
-            for (unsigned b = a; b > near; --b) p[b] = p[b - 1];
-            p[near++] = q;
-        }
-        near_end[k] = begin + near;
+        while (pairs < v.near && p[pairs] < wall_partner_base) ++pairs;
+        sort_row(p, pairs);
+        sort_row(q, v.far);
         const unsigned* order = scan.grid.order; // old slot of each rank
         const unsigned me = order[k];
-        for (unsigned a = 0; a < n; ++a) {
+        for (unsigned a = 0; a < v.near; ++a) {
             const unsigned code = p[a];
             unsigned m = 0;
             bool found = false, mirror = false;
@@ -304,19 +325,29 @@ struct fill_entries {
                 found = old.find(me, code, m);
             } else {
                 const unsigned them = order[code];
-                if (a < near) {
-                    found = old.find(me, them, m);
-                    if (!found) found = mirror = old.find(them, me, m);
-                }
+                found = old.find(me, them, m);
+                if (!found) found = mirror = old.find(them, me, m);
                 p[a] = keep_order ? them : code;
             }
             if (found) history.copy(begin + a, old.history, m, mirror);
             else history.clear(begin + a);
         }
+        if (keep_order)
+            for (unsigned a = 0; a < v.far; ++a) q[a] = order[q[a]];
     }
 };
 
-/// How many entries of row r have a non-zero history, counted at the row's particle's slot.
+/// Calls f(e) for each entry of rank r's rows that has a history: its near row, and its far
+/// row when those have histories.
+template <class Real, class F>
+SPHERE_HDI void for_each_history(const contact_view<Real>& c, std::size_t r, F&& f)
+{
+    for (unsigned e = c.offset[r]; e < c.offset[r + 1]; ++e) f(e);
+    if (c.far_history)
+        for (unsigned e = c.far_begin(r); e < c.far_end(r); ++e) f(e);
+}
+
+/// How many entries of rank r have a non-zero history, counted at the rank's particle's slot.
 template <class Real>
 struct count_histories {
     contact_view<Real> c;
@@ -324,12 +355,12 @@ struct count_histories {
     SPHERE_HD void operator()(std::size_t r) const
     {
         unsigned kept = 0;
-        for (unsigned e = c.offset[r]; e < c.offset[r + 1]; ++e) kept += c.history.has(e);
+        for_each_history(c, r, [&](unsigned e) { kept += c.history.has(e); });
         count[c.slot(r)] = kept;
     }
 };
 
-/// Copies the entries of row r with a non-zero history to the kept entries, in a row by the
+/// Copies the entries of rank r with a non-zero history to the kept entries, in a row by the
 /// particle's slot; nothing when they do not fit `capacity` (to_offset[n] is their total).
 template <class Real>
 struct copy_histories {
@@ -342,13 +373,26 @@ struct copy_histories {
     {
         if (to_offset[c.n] > capacity) return;
         unsigned k = to_offset[c.slot(r)];
-        for (unsigned e = c.offset[r]; e < c.offset[r + 1]; ++e) {
+        for_each_history(c, r, [&](unsigned e) {
             if (c.history.has(e)) {
                 to_partner[k] = c.partner[e];
                 to_history.copy(k, c.history, e, false);
                 ++k;
             }
-        }
+        });
+    }
+};
+
+/// Clears the far rows' histories (and recorded forces) from entry `first` on.
+template <class Real>
+struct clear_far_histories {
+    history_view<Real> history;
+    vec4<Real>* force;
+    std::size_t first;
+    SPHERE_HD void operator()(std::size_t k) const
+    {
+        history.clear(first + k);
+        if (force) force[first + k] = vec4<Real>{0, 0, 0, 0};
     }
 };
 
@@ -359,19 +403,22 @@ struct row_wraps {
     SPHERE_HD unsigned operator()(std::size_t r) const { return offset[r + 1] < offset[r] ? 1u : 0u; }
 };
 
-/// Writes the totals of a rebuild from its scans (kept entries, new entries) and whether they
-/// exceed the capacities (totals->wrapped, found before, counts as exceeding them).
+/// Writes the totals of a rebuild from its scans (kept entries, new entries, near rows'
+/// entries) and whether they exceed the capacities (totals->wrapped, found before, counts as
+/// exceeding them).
 struct record_totals {
     const unsigned* kept_offset;
     const unsigned* offset;
-    std::size_t n, kept_capacity, entry_capacity;
+    std::size_t n, kept_capacity, entry_capacity, history_capacity;
     list_totals* totals;
     SPHERE_HD void operator()(std::size_t) const
     {
         totals->kept = kept_offset[n];
-        totals->entries = offset[n];
+        totals->entries = offset[2 * n];
+        totals->near_entries = offset[n];
         totals->wall_particles = 0;
-        totals->overflow = kept_offset[n] > kept_capacity || offset[n] > entry_capacity || totals->wrapped;
+        totals->overflow = kept_offset[n] > kept_capacity || offset[2 * n] > entry_capacity ||
+                           offset[n] > history_capacity || totals->wrapped;
     }
 };
 
@@ -410,14 +457,10 @@ struct record_wall_particles {
 /// Empties every row of lists that overflowed, so that nothing reads past their arrays.
 struct empty_if_overflow {
     unsigned* offset;
-    unsigned* near_end;
-    std::size_t n;
     const list_totals* totals;
     SPHERE_HD void operator()(std::size_t r) const
     {
-        if (!totals->overflow) return;
-        offset[r] = 0;
-        if (r < n) near_end[r] = 0;
+        if (totals->overflow) offset[r] = 0;
     }
 };
 
@@ -448,17 +491,24 @@ public:
     /// Empty lists for n particles whose histories have `shape` (the contact law's,
     /// contact/history.cuh); `record_forces` keeps each entry's force of the last step.
     contact_lists(std::size_t n, bool record_forces, history_shape shape = {})
-        : record_forces_(record_forces), offset_(n + 1, 0u), next_offset_(n + 1, 0u), near_end_(n, 0u), history_(shape),
+        : record_forces_(record_forces), offset_(2 * n + 1, 0u), next_offset_(2 * n + 1, 0u), history_(shape),
           kept_offset_(n + 1, 0u), kept_history_(shape), wall_ranks_(n, no_rank)
     {
     }
 
-    std::size_t size() const { return offset_.size() - 1; }
+    std::size_t size() const { return (offset_.size() - 1) / 2; }
     /// Entries in all lists: each pair once, and each particle's walls within reach (host
     /// copy, from the last settled rebuild).
     std::size_t entries() const { return entries_; }
+    /// Of those, the entries of the near rows (host copy).
+    std::size_t near_entries() const { return near_entries_; }
     /// How many entries the lists' arrays hold (at least entries()).
     std::size_t capacity() const { return partner_.size(); }
+    /// How many entries the histories' arrays hold: at least near_entries(), and entries()
+    /// once the far rows have histories.
+    std::size_t history_capacity() const { return history_.size(); }
+    /// Whether the far rows' entries have histories (open_far_rows()).
+    bool far_histories() const { return far_history_; }
     /// How many rebuilds overflowed the capacities and ran again.
     std::size_t overflows() const { return overflows_; }
     bool records_forces() const { return record_forces_; }
@@ -480,31 +530,33 @@ public:
     /// ranks); partners are stored as ranks, to be the slots once the caller permutes the
     /// particles into that order, or, with `keep_order`, as the current slots, which the
     /// particles keep. Walls within r + skin are listed too; the partners within r_a + r_b +
-    /// near_skin (at most skin) come first in each row. When the histories to carry over or
-    /// the new entries exceed the capacities, the new lists are empty and the old ones (or
-    /// their histories) stay for the rebuild to run again after settle().
+    /// near_skin (at most skin) go to the near rows, the others to the far rows, which have no
+    /// histories until open_far_rows(). When the histories to carry over or the new entries
+    /// exceed the capacities, the new lists are empty and the old ones (or their histories)
+    /// stay for the rebuild to run again after settle().
     void rebuild(execution_context<Policy>& ctx, const grid_view<Coord>& grid, const wall_set<Coord>& walls, Coord skin,
                  Coord near_skin, bool keep_order, list_totals* totals)
     {
         const std::size_t n = size();
         if (!histories_kept_) keep_histories(ctx);
         histories_kept_ = true;
-        const detail::neighbour_scan<Coord> scan{grid, walls, skin};
-        unsigned* offset = next_offset_.data();
+        const detail::neighbour_scan<Coord> scan{grid, walls, skin, near_skin};
+        unsigned* offset = next_offset_.data(); // the near rows' lengths, then the far rows'
         for_each_index(Policy{}, n, detail::count_entries<Coord>{scan, offset});
-        for_each_index(Policy{}, 1, detail::fill_value<unsigned>{offset + n, 0u});
-        exclusive_scan(ctx, offset, n + 1);
+        for_each_index(Policy{}, 1, detail::fill_value<unsigned>{offset + 2 * n, 0u});
+        exclusive_scan(ctx, offset, 2 * n + 1);
         // The kept entries are at most the old lists' entries: only the new ones can wrap.
-        transform_reduce_into(ctx, n, detail::row_wraps{offset}, 0u, max_op{}, &totals->wrapped);
+        transform_reduce_into(ctx, 2 * n, detail::row_wraps{offset}, 0u, max_op{}, &totals->wrapped);
         for_each_index(Policy{}, 1,
-                       detail::record_totals{kept_offset_.data(), offset, n, kept_capacity(), capacity(), totals});
+                       detail::record_totals{kept_offset_.data(), offset, n, kept_capacity(), capacity(),
+                                             history_capacity(), totals});
         const detail::old_lists<Real> old{kept_offset_.data(), kept_partner_.data(), kept_history_.view()};
         for_each_index(Policy{}, n,
-                       detail::fill_entries<Coord, Real>{scan, near_skin, offset, near_end_.data(), partner_.data(),
-                                                         history_.view(), old, keep_order, totals});
-        if (record_forces_) for_each_index(Policy{}, capacity(), detail::fill_value<vec4<Real>>{force_.data(), {0, 0, 0, 0}});
+                       detail::fill_entries<Coord, Real>{scan, offset, partner_.data(), history_.view(), old, keep_order,
+                                                         totals});
+        if (record_forces_) for_each_index(Policy{}, force_.size(), detail::fill_value<vec4<Real>>{force_.data(), {0, 0, 0, 0}});
         set_wall_ranks(ctx, offset, totals);
-        for_each_index(Policy{}, n + 1, detail::empty_if_overflow{offset, near_end_.data(), n, totals});
+        for_each_index(Policy{}, 2 * n + 1, detail::empty_if_overflow{offset, totals});
         if (keep_order) {
             if (slot_of_rank_.size() != n) {
                 slot_of_rank_.resize(n);
@@ -515,18 +567,33 @@ public:
         }
         offset_.swap(next_offset_);
         keep_order_ = keep_order;
+        old_far_history_ = far_history_;
+        far_history_ = false;
         if constexpr (runs_in_blocks<Policy>) set_layers(grid);
     }
 
-    /// Makes room for at least `entries` entries and `kept` carried histories, so that
-    /// rebuilds up to those sizes neither allocate nor overflow.
+    /// Gives the far rows' entries histories (none: they were apart) and recorded forces
+    /// (zero), for a step that must walk them, until the next rebuild; false when they had
+    /// them already. The first time, the histories' arrays grow to the lists' capacity (an
+    /// allocation, which later lists of no more entries do not repeat).
+    bool open_far_rows()
+    {
+        if (far_history_) return false;
+        const std::size_t first = near_entries_, far = entries_ - near_entries_;
+        reserve_histories(capacity());
+        for_each_index(Policy{}, far,
+                       detail::clear_far_histories<Real>{history_.view(), record_forces_ ? force_.data() : nullptr, first});
+        far_history_ = true;
+        return true;
+    }
+
+    /// Makes room for at least `entries` entries (and their histories, far rows' included)
+    /// and `kept` carried histories, so that rebuilds up to those sizes neither allocate nor
+    /// overflow.
     void reserve(std::size_t entries, std::size_t kept)
     {
-        if (entries > capacity()) {
-            partner_.resize(entries);
-            history_.resize(entries);
-            if (record_forces_) force_.resize(entries);
-        }
+        if (entries > capacity()) partner_.resize(entries);
+        reserve_histories(entries);
         if (kept > kept_capacity()) {
             kept_partner_.resize(kept);
             kept_history_.resize(kept);
@@ -545,6 +612,7 @@ public:
                          "offsets hold; use a smaller skin or fewer particles per simulation");
         if (!t.overflow) {
             entries_ = t.entries;
+            near_entries_ = t.near_entries;
             wall_particles_ = t.wall_particles;
             histories_kept_ = false;
             return true;
@@ -552,10 +620,13 @@ public:
         ++overflows_;
         if (t.kept > kept_capacity()) {
             offset_.swap(next_offset_); // the old lists are whole: their histories were not copied
+            far_history_ = old_far_history_;
             histories_kept_ = false;
         }
         const auto grown = [&](std::size_t needed) { return headroom ? needed + needed / 4 + 64 : needed; };
-        reserve(t.entries > capacity() ? grown(t.entries) : 0, t.kept > kept_capacity() ? grown(t.kept) : 0);
+        if (t.entries > capacity()) partner_.resize(grown(t.entries));
+        if (t.near_entries > history_capacity()) reserve_histories(grown(t.near_entries));
+        if (t.kept > kept_capacity()) reserve(0, grown(t.kept));
         return false;
     }
 
@@ -568,7 +639,7 @@ public:
                 record_forces_ ? force_.data() : nullptr,
                 keep_order_ ? slot_of_rank_.data() : nullptr,
                 keep_order_ ? rank_of_slot_.data() : nullptr,
-                near_end_.data()};
+                far_history_};
     }
 
     /// A host copy in user order, each pair from both sides; `user` is the user index of each
@@ -592,14 +663,16 @@ public:
         items.reserve(2 * part.size());
         for (std::size_t r = 0; r < n; ++r) {
             const unsigned me = user[keep_order_ ? slots[r] : r];
-            for (unsigned e = off[r]; e < off[r + 1]; ++e) {
+            const auto add = [&](unsigned e) {
                 if (part[e] >= wall_partner_base) {
                     items.push_back({me, part[e], e, false});
                 } else {
                     items.push_back({me, user[part[e]], e, false});
                     items.push_back({user[part[e]], me, e, true});
                 }
-            }
+            };
+            for (unsigned e = off[r]; e < off[r + 1]; ++e) add(e);
+            for (unsigned e = off[n + r]; e < off[n + r + 1]; ++e) add(e);
         }
         std::sort(items.begin(), items.end(), [](const item& a, const item& b) {
             return a.particle != b.particle ? a.particle < b.particle : a.partner < b.partner;
@@ -615,14 +688,16 @@ public:
         if (record_forces_) t.force.reserve(items.size());
         for (const item& it : items) {
             t.partner.push_back(it.partner);
-            const vec4<Real> h = hist[it.entry];
+            // a far row's entry without a history has none and no force (it is apart)
+            const bool stored = far_history_ || it.entry < off[n];
+            const vec4<Real> h = stored ? hist[it.entry] : vec4<Real>{0, 0, 0, 0};
             t.history.push_back(vec_cast<Coord>(it.mirrored ? mirrored(h) : h));
             for (unsigned l = 0; l < shape.lanes; ++l) {
-                const Real v = lanes[it.entry * shape.lanes + l];
+                const Real v = stored ? lanes[it.entry * shape.lanes + l] : Real(0);
                 t.lane.push_back(Coord(it.mirrored && (shape.mirror >> l & 1u) ? -v : v));
             }
             if (record_forces_) {
-                const vec4<Real> f = frc[it.entry];
+                const vec4<Real> f = stored ? frc[it.entry] : vec4<Real>{0, 0, 0, 0};
                 t.force.push_back(vec_cast<Coord>(it.mirrored ? mirrored(f) : f));
             }
         }
@@ -632,8 +707,9 @@ public:
     /// Replaces the lists by a table in user order (for restarts): `grid` is built over the
     /// positions of the last rebuild in user order (its `order` holds the user index of each
     /// rank), and the particles are stored in rank order unless `keep_order` (then in user
-    /// order). Each pair takes the history its owner's entry has in the table; rows list the
-    /// partners within r_a + r_b + near_skin of those positions first, as rebuild() does.
+    /// order). Each pair takes the history its owner's entry has in the table; the partners
+    /// within r_a + r_b + near_skin of those positions go to the near rows, as rebuild() puts
+    /// them, and the far rows have histories (a restored table's far pairs may have one).
     /// Throws when the table does not fit or is not symmetric.
     void restore(const contact_table<Coord>& t, const grid_view<Coord>& grid, Coord near_skin, bool keep_order)
     {
@@ -656,13 +732,15 @@ public:
             if (la == lb) return a < b;
             return lb == la + 1 || (g.box.periodic(g.slow) && layers >= 3 && la == layers - 1 && lb == 0);
         };
-        std::vector<unsigned> off(n + 1, 0), part, near_end(n);
-        std::vector<vec4<Real>> hist;
-        std::vector<Real> lanes;
-        // the table's entry e as the lists store it: its base, then its lanes
-        auto take = [&](std::size_t e) {
-            hist.push_back(vec_cast<Real>(t.history[e]));
-            for (unsigned l = 0; l < shape.lanes; ++l) lanes.push_back(Real(t.lane[e * shape.lanes + l]));
+        std::vector<unsigned> off(2 * n + 1, 0), part, far_part;
+        std::vector<vec4<Real>> hist, far_hist;
+        std::vector<Real> lanes, far_lanes;
+        std::vector<std::size_t> far_rows(n + 1, 0);
+        // the table's entry e as the lists store it: its partner, its base, then its lanes
+        auto take = [&](bool near, unsigned code, std::size_t e) {
+            (near ? part : far_part).push_back(code);
+            (near ? hist : far_hist).push_back(vec_cast<Real>(t.history[e]));
+            for (unsigned l = 0; l < shape.lanes; ++l) (near ? lanes : far_lanes).push_back(Real(t.lane[e * shape.lanes + l]));
         };
         for (std::size_t r = 0; r < n; ++r) {
             const unsigned i = user_of_rank[r];
@@ -685,33 +763,30 @@ public:
                 if (owns(unsigned(r), q)) row.emplace_back(q, e);
             }
             std::sort(row.begin(), row.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-            const auto far = std::stable_partition(row.begin(), row.end(), [&](const auto& a) {
-                return detail::within_skin(g.box, x[r], x[a.first], near_skin);
-            });
-            near_end[r] = static_cast<unsigned>(part.size() + std::size_t(far - row.begin()));
             std::sort(walls.begin(), walls.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-            for (const auto& [q, e] : row) {
-                part.push_back(keep_order ? user_of_rank[q] : q);
-                take(e);
-            }
-            for (const auto& [code, e] : walls) {
-                part.push_back(code);
-                take(e);
-            }
+            for (const auto& [q, e] : row)
+                take(detail::within_skin(g.box, x[r], x[q], near_skin), keep_order ? user_of_rank[q] : q, e);
+            for (const auto& [code, e] : walls) take(true, code, e);
             off[r + 1] = static_cast<unsigned>(part.size());
+            far_rows[r + 1] = far_part.size();
         }
         std::vector<unsigned> wall_ranks(n, no_rank);
         std::size_t with_walls = 0;
         for (std::size_t r = 0; r < n; ++r)
             if (off[r + 1] > off[r] && part[off[r + 1] - 1] >= wall_partner_base) wall_ranks[with_walls++] = unsigned(r);
+        near_entries_ = part.size();
+        for (std::size_t r = 0; r <= n; ++r) off[n + r] = static_cast<unsigned>(near_entries_ + far_rows[r]);
+        part.insert(part.end(), far_part.begin(), far_part.end());
+        hist.insert(hist.end(), far_hist.begin(), far_hist.end());
+        lanes.insert(lanes.end(), far_lanes.begin(), far_lanes.end());
         offset_.assign(off);
-        near_end_.assign(near_end);
         partner_.assign(part);
         history_.assign(hist, lanes);
         wall_ranks_.assign(wall_ranks);
         entries_ = part.size();
         wall_particles_ = with_walls;
         histories_kept_ = false;
+        far_history_ = true;
         if (record_forces_) force_.assign(std::vector<vec4<Real>>(part.size(), vec4<Real>{0, 0, 0, 0}));
         keep_order_ = keep_order;
         if (keep_order) {
@@ -723,6 +798,14 @@ public:
 
 private:
     std::size_t kept_capacity() const { return kept_partner_.size(); }
+
+    /// Makes room for the histories (and recorded forces) of at least `entries` entries.
+    void reserve_histories(std::size_t entries)
+    {
+        if (entries <= history_capacity()) return;
+        history_.resize(entries);
+        if (record_forces_) force_.resize(entries);
+    }
 
     /// Copies the entries whose history is not zero (contacts that touched at the last step,
     /// whose history a rebuild carries over) into the kept entries, in rows by slot.
@@ -753,17 +836,18 @@ private:
         for_each_index(Policy{}, 1, detail::record_wall_particles{place, n, totals});
     }
 
-    /// The layers of the grid as ranks and entries, for the host's slab schedule (reads the
-    /// grid's cell starts and the offsets in place: host memory).
+    /// The layers of the grid as ranks and entries (both rows'), for the host's slab schedule
+    /// (reads the grid's cell starts and the offsets in place: host memory).
     void set_layers(const grid_view<Coord>& grid)
     {
         const grid_geometry<Coord>& g = grid.geometry;
-        const std::size_t layers = g.layers(), per_layer = g.cells_per_layer();
+        const std::size_t layers = g.layers(), per_layer = g.cells_per_layer(), n = size();
+        const unsigned* off = offset_.data();
         layer_start_.resize(layers + 1);
         layer_entries_.resize(layers + 1);
         for (std::size_t l = 0; l <= layers; ++l) {
             layer_start_[l] = grid.cell_start[l * per_layer];
-            layer_entries_[l] = offset_.data()[layer_start_[l]];
+            layer_entries_[l] = off[layer_start_[l]] + (off[n + layer_start_[l]] - off[n]);
         }
         periodic_layers_ = g.box.periodic(g.slow);
     }
@@ -781,13 +865,14 @@ private:
     bool keep_order_ = false;
     bool periodic_layers_ = false;
     bool histories_kept_ = false; ///< the kept entries hold the histories of the lists in use
-    std::size_t entries_ = 0, overflows_ = 0;
-    buffer<unsigned, Policy> offset_;      ///< row r: entries [offset_[r], offset_[r + 1])
+    bool far_history_ = false;     ///< far_histories()
+    bool old_far_history_ = false; ///< far_history_ of the lists before the last rebuild
+    std::size_t entries_ = 0, near_entries_ = 0, overflows_ = 0;
+    buffer<unsigned, Policy> offset_;      ///< the near rows, then the far rows (contact_view::offset)
     buffer<unsigned, Policy> next_offset_; ///< the rows a rebuild counts (then swapped with offset_)
-    buffer<unsigned, Policy> near_end_;    ///< row r's near partners: [offset_[r], near_end_[r])
     buffer<unsigned, Policy> partner_;     ///< capacity() entries
-    history_store<Real, Policy> history_;
-    buffer<vec4<Real>, Policy> force_;
+    history_store<Real, Policy> history_;  ///< history_capacity() entries
+    buffer<vec4<Real>, Policy> force_;     ///< history_capacity() entries when recorded
     // The histories a rebuild carries over, in rows by slot (kept between rebuilds: their
     // arrays only grow).
     buffer<unsigned, Policy> kept_offset_, kept_partner_;

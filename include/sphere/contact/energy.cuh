@@ -79,26 +79,29 @@ struct particle_energy {
         e.rotational = Coord(0.2) * m * xi.w * xi.w * Coord(norm2(p.omega_sync[i]));
         e.potential = -m * dot(gravity, xi.xyz());
         const std::size_t r = c.rank(i);
-        for (unsigned k = c.offset[r]; k < c.offset[r + 1]; ++k) {
-            const unsigned j = c.partner[k];
-            if (j < wall_partner_base) {
-                pair_separation<Real> s;
-                if (!separate<Law>(pair_params, box, xi, p.x[j], s)) continue;
-                contact_geometry<Real> g;
-                pair_geometry<materials>(g, p, i, j, s);
-                law_history_t<Law, Real> h;
-                c.history.load(k, h);
-                e.elastic += Coord(Law::pair_energy(pair_params, g, h));
-            } else {
-                const int f = static_cast<int>(j - wall_partner_base);
-                const int a = f / 2;
-                const vec3<Real> n = wall_set<Real>::inward_normal(f);
-                contact_geometry<Real> g;
-                wall_geometry<materials>(g, p, i, f, n, Real((xi.xyz()[a] - Coord(walls.face[f].position)) * Coord(n[a]) - xi.w));
-                law_history_t<Law, Real> h;
-                c.history.load(k, h);
-                if (g.delta_n < Real(0)) e.elastic += Coord(Law::wall_energy(wall_params, g, h));
-            }
+        const auto pair = [&](unsigned k, unsigned j) {
+            pair_separation<Real> s;
+            if (!separate<Law>(pair_params, box, xi, p.x[j], s)) return;
+            contact_geometry<Real> g;
+            pair_geometry<materials>(g, p, i, j, s);
+            law_history_t<Law, Real> h{}; // a far row's entry without a history has none
+            if (c.has_history(k)) c.history.load(k, h);
+            e.elastic += Coord(Law::pair_energy(pair_params, g, h));
+        };
+        // the near row's partners, the far row's, then the near row's walls
+        unsigned walls_from = c.offset[r];
+        for (; walls_from < c.offset[r + 1] && c.partner[walls_from] < wall_partner_base; ++walls_from)
+            pair(walls_from, c.partner[walls_from]);
+        for (unsigned k = c.far_begin(r); k < c.far_end(r); ++k) pair(k, c.partner[k]);
+        for (unsigned k = walls_from; k < c.offset[r + 1]; ++k) {
+            const int f = static_cast<int>(c.partner[k] - wall_partner_base);
+            const int a = f / 2;
+            const vec3<Real> n = wall_set<Real>::inward_normal(f);
+            contact_geometry<Real> g;
+            wall_geometry<materials>(g, p, i, f, n, Real((xi.xyz()[a] - Coord(walls.face[f].position)) * Coord(n[a]) - xi.w));
+            law_history_t<Law, Real> h;
+            c.history.load(k, h);
+            if (g.delta_n < Real(0)) e.elastic += Coord(Law::wall_energy(wall_params, g, h));
         }
         if (p.e_visc) { // the energy audit is on
             e.dissipated_visc = p.e_visc[i];

@@ -68,9 +68,10 @@ struct pair_tile {
 
 /// The pair sums of the host's slab schedule, for the owners of a range of ranks: pairs are
 /// gathered into tiles in row order, evaluated lane-parallel, then added to both particles in
-/// tile order (so each particle's sum has a fixed order). `near_only`: walk each row's near
-/// partners alone (contact/contact_lists.cuh; the caller knows that the others are apart and
-/// without history, so the sums and histories are the same bits either way).
+/// tile order (so each particle's sum has a fixed order), each owner's near row first, then
+/// its far row. `near_only`: walk the near rows alone (contact/contact_lists.cuh; the caller
+/// knows that the far partners are apart and without history, so the sums and histories are
+/// the same bits either way).
 template <class P, class Law, bool Book, bool Record, bool OneVelocity>
 struct slab_pairs {
     using Real = real_t<P>;
@@ -92,11 +93,9 @@ struct slab_pairs {
         const world<Coord> box = eval.box;
         const auto params = eval.params;
         for (unsigned r = first_rank; r < end_rank; ++r) {
-            const unsigned i = static_cast<unsigned>(c.slot(r)), end = near_only ? c.near_end[r] : c.offset[r + 1];
+            const unsigned i = static_cast<unsigned>(c.slot(r));
             const vec4<Coord> xi = x[i];
-            for (unsigned e = c.offset[r]; e < end; ++e) {
-                const unsigned j = partner[e];
-                if (j >= wall_partner_base) break; // walls come last in a row
+            const auto pair = [&](unsigned e, unsigned j) {
                 t.owner[t.count] = i;
                 t.partner[t.count] = j;
                 t.entry[t.count] = e;
@@ -118,7 +117,14 @@ struct slab_pairs {
                 apart_count += !touching;
                 if (apart_count == tile::width) forget(apart, apart_count);
                 if (t.count == tile::width) flush(t);
+            };
+            for (unsigned e = c.offset[r], end = c.offset[r + 1]; e < end; ++e) {
+                const unsigned j = partner[e];
+                if (j >= wall_partner_base) break; // walls come last in a near row
+                pair(e, j);
             }
+            if (!near_only)
+                for (unsigned e = c.far_begin(r), end = c.far_end(r); e < end; ++e) pair(e, partner[e]);
         }
         if (t.count) flush(t);
         forget(apart, apart_count);
@@ -361,10 +367,11 @@ struct no_finish {
     void operator()(unsigned, unsigned, int) const {}
 };
 
-/// The gather schedule, first pass (one index per rank): evaluates the owner's pairs and
-/// stores each pair's result. `near_only`: the owner's near partners alone (the caller knows
-/// that the others are apart and that their stored results are zero from the walk that last
-/// found them apart).
+/// The gather schedule, first pass (one index per rank): evaluates the owner's pairs (its near
+/// row, then its far row) and stores each pair's result. `near_only`: the near row alone (the
+/// caller knows that the far partners are apart and that their stored results are zero from
+/// the walk that last found them apart). Far rows without histories are apart (the caller
+/// opens them for a step that may find them touching): their results are zero.
 template <class P, class Law, bool Book, bool Record, bool OneVelocity>
 struct evaluate_owned_pairs {
     using Real = real_t<P>;
@@ -380,25 +387,35 @@ struct evaluate_owned_pairs {
     SPHERE_HD void operator()(std::size_t r) const
     {
         const std::size_t i = c.slot(r);
-        const unsigned end = near_only ? c.near_end[r] : c.offset[r + 1];
-        for (unsigned e = c.offset[r]; e < end; ++e) {
-            const unsigned j = c.partner[e];
-            if (j >= wall_partner_base) break;
-            law_history_t<Law, Real> h;
-            c.history.load(e, h);
-            pair_result<Real> res = eval.evaluate(i, j, h);
-            if (update_history) c.history.store(e, h);
-            if (Record) c.force[e] = res.record;
-            force[e] = res.force;
-            torque_i[e] = res.torque_i;
-            torque_j[e] = res.torque_j;
-            if (Book) audit[e] = {res.fn, res.visc_rate / 2, res.fric_rate / 2};
+        for (unsigned e = c.offset[r]; e < c.offset[r + 1] && c.partner[e] < wall_partner_base; ++e) pair(i, e);
+        if (near_only) return;
+        for (unsigned e = c.far_begin(r); e < c.far_end(r); ++e) {
+            if (c.far_history) {
+                pair(i, e);
+            } else {
+                force[e] = torque_i[e] = torque_j[e] = vec3<Real>{0, 0, 0};
+                if (Book) audit[e] = vec3<Real>{0, 0, 0};
+            }
         }
+    }
+
+private:
+    SPHERE_HD void pair(std::size_t i, unsigned e) const
+    {
+        law_history_t<Law, Real> h;
+        c.history.load(e, h);
+        pair_result<Real> res = eval.evaluate(i, c.partner[e], h);
+        if (update_history) c.history.store(e, h);
+        if (Record) c.force[e] = res.record;
+        force[e] = res.force;
+        torque_i[e] = res.torque_i;
+        torque_j[e] = res.torque_j;
+        if (Book) audit[e] = {res.fn, res.visc_rate / 2, res.fric_rate / 2};
     }
 };
 
-/// The gather schedule, second pass (one index per slot): the particle's own pairs, then the
-/// pairs that list it as partner (in their owners' rank order).
+/// The gather schedule, second pass (one index per slot): the particle's own pairs (its near
+/// row, then its far row), then the pairs that list it as partner (build_reverse's order).
 template <class P, bool Book>
 struct gather_pair_results {
     using Real = real_t<P>;
@@ -416,11 +433,13 @@ struct gather_pair_results {
         const std::size_t r = c.rank(s);
         vec3<Real> f{0, 0, 0}, t{0, 0, 0}, a{0, 0, 0};
         const unsigned end = c.offset[r + 1];
-        for (unsigned e = c.offset[r]; e < end && c.partner[e] < wall_partner_base; ++e) {
+        const auto own = [&](unsigned e) {
             f += force[e];
             t += torque_i[e];
             if (Book) a += audit[e];
-        }
+        };
+        for (unsigned e = c.offset[r]; e < end && c.partner[e] < wall_partner_base; ++e) own(e);
+        for (unsigned e = c.far_begin(r); e < c.far_end(r); ++e) own(e);
         for (unsigned m = reverse_offset[r]; m < reverse_offset[r + 1]; ++m) {
             const unsigned e = reverse_entry[m];
             f -= force[e];
@@ -447,7 +466,7 @@ struct reverse_keys {
     SPHERE_HD void operator()(std::size_t e) const
     {
         const unsigned j = c.partner[e];
-        const bool pair = e < c.offset[c.n] && j < wall_partner_base; // not a wall, nor past the entries
+        const bool pair = e < c.entries() && j < wall_partner_base; // not a wall, nor past the entries
         key[e] = pair ? static_cast<unsigned>(c.rank(j)) : static_cast<unsigned>(c.n);
         entry[e] = static_cast<unsigned>(e);
     }
@@ -539,6 +558,8 @@ public:
     }
 
 private:
+    /// The pairs of each partner, in entry order: the near rows' by owner rank, then the far
+    /// rows' by owner rank.
     void build_reverse(execution_context<Policy>& ctx, const contact_view<Real>& c, std::size_t entries, std::size_t n)
     {
         if (reverse_entry_.size() < entries) {
