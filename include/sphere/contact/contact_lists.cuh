@@ -574,11 +574,11 @@ public:
 
     /// Gives the far rows' entries histories (none: they were apart) and recorded forces
     /// (zero), for a step that must walk them, until the next rebuild; false when they had
-    /// them already. The first time, the histories' arrays grow to the lists' capacity (an
-    /// allocation, which later lists of no more entries do not repeat).
+    /// them already or are empty. The first time, the histories' arrays grow to the lists'
+    /// capacity (an allocation, which later lists of no more entries do not repeat).
     bool open_far_rows()
     {
-        if (far_history_) return false;
+        if (far_history_ || entries_ == near_entries_) return false;
         const std::size_t first = near_entries_, far = entries_ - near_entries_;
         reserve_histories(capacity());
         for_each_index(Policy{}, far,
