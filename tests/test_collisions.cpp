@@ -900,4 +900,34 @@ TEMPLATE_TEST_CASE("damping ratios: every pair has the restitution its ratio giv
                         Catch::Contains("settings.contact.gamma_t = -1 (ratio to critical damping): must be non-negative"));
 }
 
+TEMPLATE_TEST_CASE("particles at rest: the pair sums walk the near partners alone and never open the far rows",
+                   "[collision][near]", float, double, sphere::mixed)
+{
+    using P = TestType;
+    using Real = user_real<P>;
+    // Three balls of set P at rest in a row, no gravity, skin r / 5: a and b a twentieth of
+    // the skin apart (near partners: within an eighth of the skin; apart), c half the skin
+    // beyond b (listed, in b's or c's far row). Nothing moves, so no particle ever moves a
+    // sixteenth of the skin: the pair sums walk the near rows alone at every step (on the
+    // gather schedule from the second on: its first walks every entry to store the far pair's
+    // zero result) and the far rows never get histories (docs/architecture.md, *Near
+    // partners*). In sphere_cuda_tests this checks that the CUDA step hands `near_only` over.
+    const Real r = set_p<Real>::radius, skin = r / 5;
+    sphere::settings<Real> s = box_settings<Real>();
+    s.skin = skin;
+    s.pair_summation = GENERATE(sphere::pair_summation::automatic, sphere::pair_summation::gather);
+    const Real xb = 2 * r + skin / 20, xc = xb + 2 * r + skin / 2;
+    test_sim<P> sim(s, {ball<Real>({0, 0, 0}), ball<Real>({xb, 0, 0}), ball<Real>({xc, 0, 0})});
+    const std::size_t steps = 50;
+    sim.run(steps);
+    INFO("pair summation " << unsigned(s.pair_summation) << ": " << sim.near_walks() << " of " << steps
+                           << " steps on the near partners alone");
+    CHECK(sim.contact_entries() == 2); // {a, b} and {b, c}
+    CHECK(sim.rebuilds() == 1);
+    CHECK(sim.near_walks() >= steps - 1);
+    CHECK(sim.far_openings() == 0);
+    const auto snap = sim.snapshot();
+    for (std::size_t i = 0; i < 3; ++i) CHECK(snap.v[i] == vec3<Real>{0, 0, 0}); // apart: no force
+}
+
 } // namespace test_collisions
