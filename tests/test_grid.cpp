@@ -834,7 +834,8 @@ TEMPLATE_TEST_CASE("contact lists give histories to their near rows only, until 
     using Real = TestType;
     // Three spheres of radius 1 mm in a row on the floor of a box with walls: a touches b; c
     // lies 0.5 skin beyond b, within the skin but not within the near skin (an eighth of it),
-    // so the lists hold a near pair {a, b}, the three floor contacts and a far pair {b, c}. A resting bed never walks its far rows: their histories take no memory
+    // so the lists hold a near pair {a, b}, the three floor contacts and a far pair {b, c}.
+    // A resting bed never walks its far rows: their histories take no memory
     // (docs/architecture.md, *Near partners*) until a step must walk them.
     const Real r = Real(0.001), skin = Real(0.0004);
     sphere::world<Real> box;

@@ -149,7 +149,7 @@ struct row_overlap {
         const vec4<Coord> xi = p.x[i];
         const double coincident = deepest_overlap::coincident;
         deepest_overlap out{0, ~0u, ~0u};
-        const auto pair = [&](unsigned j) {
+        c.for_each_pair(r, [&](unsigned, unsigned j) {
             const vec4<Coord> xj = p.x[j];
             const vec3<Coord> d = box.nearest_image_inside(xi.xyz() - xj.xyz());
             const double dist = std::sqrt(double(norm2(d))), smaller = double(xi.w < xj.w ? xi.w : xj.w);
@@ -157,9 +157,7 @@ struct row_overlap {
             const unsigned ui = p.user[i], uj = p.user[j];
             const deepest_overlap here{fraction, ui < uj ? ui : uj, ui < uj ? uj : ui};
             if (here.before(out)) out = here;
-        };
-        for (unsigned e = c.offset[r]; e < c.offset[r + 1] && c.partner[e] < wall_partner_base; ++e) pair(c.partner[e]);
-        for (unsigned e = c.far_begin(r); e < c.far_end(r); ++e) pair(c.partner[e]);
+        });
         return out;
     }
 };
@@ -940,8 +938,7 @@ private:
         // Whether the lists' other partners are apart now, and whether the pair sums may then
         // walk the near ones alone (their histories are clear: docs/architecture.md).
         const bool apart = rebuild || near_holds();
-        const bool near_only = apart && (rebuild || far_clear_);
-        if (!near_only) open_far_rows();
+        const bool near_only = walks_near_only(rebuild);
         detail::step_report<Coord> done{};
         do {
             if (rebuild) rebuild_lists(&report->lists);
@@ -1053,8 +1050,7 @@ private:
     template <bool Record>
     void initial_forces()
     {
-        const bool near_only = near_holds() && far_clear_;
-        if (!near_only) open_far_rows();
+        const bool near_only = walks_near_only(false);
         interaction_.template sum_pairs<false, Record>(context_, pair_contact(), lists_, summation_, false, near_only);
         transform_reduce_into(context_, wall_launch_, wall_contacts<false, Record>(false),
                               detail::wall_loads{{0, 0, 0, 0, 0, 0}}, plus_op{}, &report_.data()->loads);
@@ -1108,10 +1104,14 @@ private:
         needs_rebuild_ = needs_rebuild_ || rebuild;
     }
 
-    /// Gives the lists' far rows histories for a step that walks them (until the next rebuild).
-    void open_far_rows()
+    /// Whether the pair sums of a step (`rebuild`: one that rebuilds the lists first) may walk
+    /// the near rows alone: at a rebuild, or while the far partners are apart and without
+    /// history. When not, gives the far rows histories (until the next rebuild).
+    bool walks_near_only(bool rebuild)
     {
-        if (lists_.open_far_rows()) ++far_openings_;
+        const bool near_only = rebuild || (near_holds() && far_clear_);
+        if (!near_only && lists_.open_far_rows()) ++far_openings_;
+        return near_only;
     }
 
     /// The near skin (m): the lists' near rows hold the partners within r_i + r_j + near skin

@@ -90,6 +90,16 @@ struct contact_view {
     /// Whether entry e has a history (and a recorded force): every near row's entry does, a
     /// far row's only with far_history.
     SPHERE_HDI bool has_history(std::size_t e) const { return far_history || e < offset[n]; }
+    /// Calls f(e, partner) for each particle partner of rank r, its near row's then its far
+    /// row's (the order of the pair sums); returns where the near row's walls begin.
+    template <class F>
+    SPHERE_HDI unsigned for_each_pair(std::size_t r, F&& f) const
+    {
+        unsigned e = offset[r];
+        for (; e < offset[r + 1] && partner[e] < wall_partner_base; ++e) f(e, partner[e]);
+        for (unsigned k = far_begin(r); k < far_end(r); ++k) f(k, partner[k]);
+        return e;
+    }
 };
 
 /// A host copy of the contact lists in user order, each pair from both sides: entries of

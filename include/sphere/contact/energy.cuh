@@ -79,7 +79,8 @@ struct particle_energy {
         e.rotational = Coord(0.2) * m * xi.w * xi.w * Coord(norm2(p.omega_sync[i]));
         e.potential = -m * dot(gravity, xi.xyz());
         const std::size_t r = c.rank(i);
-        const auto pair = [&](unsigned k, unsigned j) {
+        // the near row's partners, the far row's, then the near row's walls
+        const unsigned walls_from = c.for_each_pair(r, [&](unsigned k, unsigned j) {
             pair_separation<Real> s;
             if (!separate<Law>(pair_params, box, xi, p.x[j], s)) return;
             contact_geometry<Real> g;
@@ -87,12 +88,7 @@ struct particle_energy {
             law_history_t<Law, Real> h{}; // a far row's entry without a history has none
             if (c.has_history(k)) c.history.load(k, h);
             e.elastic += Coord(Law::pair_energy(pair_params, g, h));
-        };
-        // the near row's partners, the far row's, then the near row's walls
-        unsigned walls_from = c.offset[r];
-        for (; walls_from < c.offset[r + 1] && c.partner[walls_from] < wall_partner_base; ++walls_from)
-            pair(walls_from, c.partner[walls_from]);
-        for (unsigned k = c.far_begin(r); k < c.far_end(r); ++k) pair(k, c.partner[k]);
+        });
         for (unsigned k = walls_from; k < c.offset[r + 1]; ++k) {
             const int f = static_cast<int>(c.partner[k] - wall_partner_base);
             const int a = f / 2;

@@ -432,14 +432,11 @@ struct gather_pair_results {
     {
         const std::size_t r = c.rank(s);
         vec3<Real> f{0, 0, 0}, t{0, 0, 0}, a{0, 0, 0};
-        const unsigned end = c.offset[r + 1];
-        const auto own = [&](unsigned e) {
+        c.for_each_pair(r, [&](unsigned e, unsigned) {
             f += force[e];
             t += torque_i[e];
             if (Book) a += audit[e];
-        };
-        for (unsigned e = c.offset[r]; e < end && c.partner[e] < wall_partner_base; ++e) own(e);
-        for (unsigned e = c.far_begin(r); e < c.far_end(r); ++e) own(e);
+        });
         for (unsigned m = reverse_offset[r]; m < reverse_offset[r + 1]; ++m) {
             const unsigned e = reverse_entry[m];
             f -= force[e];
