@@ -782,7 +782,8 @@ TEST_CASE("the slab phases let no two tasks of a phase write the same layer", "[
         }
 }
 
-TEMPLATE_TEST_CASE("every cell's start is the number of particles in lower cells, also in a tall, mostly empty box",
+TEMPLATE_TEST_CASE("every cell's start is the number of particles in lower cells, also in a tall, mostly empty box, "
+                   "and a cell's particles follow their user indices (their slots without)",
                    "[grid]", float, double)
 {
     using Real = TestType;
@@ -821,11 +822,25 @@ TEMPLATE_TEST_CASE("every cell's start is the number of particles in lower cells
     for (std::size_t c = 0; c <= g.cell_count(); ++c) wrong += v.cell_start[c] != below[c];
     CHECK(wrong == 0);
     CHECK(v.cell_start[g.cell_count()] == n);
-    // The sorted positions follow the order.
+    // The sorted positions follow the order; in a cell, the user indices rise (they fall with
+    // the slots, so the order within a cell is the ties' and not the slots').
+    std::size_t shared = 0; // pairs of particles in one cell
     for (std::size_t k = 0; k < n; ++k) {
         CHECK(v.sorted_x[k].z == x[v.order[k]].z);
-        if (k > 0) CHECK(g.cell_of(v.sorted_x[k - 1].xyz()) <= g.cell_of(v.sorted_x[k].xyz()));
+        if (k == 0) continue;
+        const unsigned before = g.cell_of(v.sorted_x[k - 1].xyz()), here = g.cell_of(v.sorted_x[k].xyz());
+        CHECK(before <= here);
+        if (before == here) {
+            ++shared;
+            CHECK(user[v.order[k - 1]] < user[v.order[k]]);
+        }
     }
+    CHECK((n == 0 || shared > 10));
+    // Without user indices the ties go by slot.
+    p.user = nullptr;
+    grid.build(context, p);
+    for (std::size_t k = 1; k < n; ++k)
+        if (g.cell_of(x[v.order[k - 1]].xyz()) == g.cell_of(x[v.order[k]].xyz())) CHECK(v.order[k - 1] < v.order[k]);
 }
 
 TEMPLATE_TEST_CASE("contact lists give histories to their near rows only, until a step must walk the far rows",

@@ -1,9 +1,11 @@
 #pragma once
 /// \file
-/// The uniform neighbour grid: hash each particle to its cell, sort by cell (ties by the
-/// particle's user index, so the order depends on positions and user indices alone, not on
-/// where the particles are stored), gather positions in cell order and find where each cell
-/// starts in the sorted order.
+/// The uniform neighbour grid: order the particles by cell (ties by the particle's user index,
+/// so the order depends on positions and user indices alone, not on where the particles are
+/// stored), gather positions in cell order and find where each cell starts in that order. On
+/// CUDA a radix sort of keys (cell, user index) orders them; on the host a counting sort by
+/// cell, which needs neither keys nor the sort's second copy of them (20 B per particle).
+#include <algorithm>
 #include <cstddef>
 #include <type_traits>
 
@@ -12,6 +14,7 @@
 #include "../exec/collectives.cuh"
 #include "../exec/context.cuh"
 #include "../exec/for_each.cuh"
+#include "../exec/policy.cuh"
 #include "../particles/state.cuh"
 #include "geometry.cuh"
 
@@ -48,6 +51,27 @@ struct hash_particles {
     }
 };
 
+/// The host's ordering: a counting sort of slots 0 .. n - 1 by cell into `order`, then each
+/// cell's slots by user index (by slot without user indices, which the counting sort gives
+/// already); start[c] is the first position of cell c, start[cells] = n. On the calling thread.
+template <class Real>
+void order_by_cell(const grid_geometry<Real>& g, const vec4<Real>* x, const unsigned* user, std::size_t n,
+                   unsigned* order, unsigned* start)
+{
+    const std::size_t cells = g.cell_count();
+    std::fill(start, start + cells + 1, 0u);
+    for (std::size_t i = 0; i < n; ++i) ++start[g.cell_of(x[i].xyz()) + 1];
+    for (std::size_t c = 0; c < cells; ++c) start[c + 1] += start[c];
+    // start[c] advances past each slot placed in cell c, ending where cell c + 1 starts
+    for (std::size_t i = 0; i < n; ++i) order[start[g.cell_of(x[i].xyz())]++] = static_cast<unsigned>(i);
+    for (std::size_t c = cells; c > 0; --c) start[c] = start[c - 1];
+    start[0] = 0;
+    if (!user) return;
+    for (std::size_t c = 0; c < cells; ++c)
+        if (start[c + 1] - start[c] > 1)
+            std::sort(order + start[c], order + start[c + 1], [user](unsigned a, unsigned b) { return user[a] < user[b]; });
+}
+
 } // namespace detail
 
 template <class Real, class Policy>
@@ -61,17 +85,15 @@ public:
     /// is laid in the type of the positions, coord_t of the particles' precision P). The
     /// positions in sorted order go to `sorted_into` (p.n elements of policy memory that the
     /// caller owns and keeps unchanged while it uses the view) or, without it, to the grid's
-    /// own array. Sorts and scans through `ctx`: no allocation once the particle count and the
-    /// caller's array stay.
+    /// own array. No allocation once the particle count and the caller's array stay (CUDA sorts
+    /// and scans through `ctx`'s scratch; the host needs none).
     template <class P>
     void build(execution_context<Policy>& ctx, const particle_view<P>& p, vec4<Real>* sorted_into = nullptr)
     {
         static_assert(std::is_same_v<coord_t<P>, Real>, "the grid is laid in the type of the positions");
         const std::size_t cells = geometry_.cell_count();
-        if (key_.size() != p.n) {
-            key_.resize(p.n);
-            order_.resize(p.n);
-        }
+        n_ = p.n;
+        if (order_.size() != p.n) order_.resize(p.n);
         if (sorted_into) {
             if (own_sorted_x_.size()) own_sorted_x_ = buffer<vec4<Real>, Policy>();
             sorted_x_ = sorted_into;
@@ -80,23 +102,29 @@ public:
             sorted_x_ = own_sorted_x_.data();
         }
         if (cell_start_.size() != cells + 1) cell_start_.resize(cells + 1);
-        const int tie_bits = bits_for(p.n - 1);
-        for_each_index(Policy{}, p.n,
-                       detail::hash_particles<Real>{geometry_, p.x, p.user, tie_bits, key_.data(), order_.data()});
-        sort_by_key(ctx, key_.data(), order_.data(), p.n, tie_bits + bits_for(cells - 1));
-        // where each cell starts, for any number of empty cells (a tall box)
-        find_starts(ctx, key_.data(), tie_bits, p.n, cells, cell_start_.data());
+        if constexpr (runs_in_blocks<Policy>) { // host memory, read and written in place
+            detail::order_by_cell(geometry_, p.x, p.user, p.n, order_.data(), cell_start_.data());
+        } else {
+            if (key_.size() != p.n) key_.resize(p.n);
+            const int tie_bits = bits_for(p.n - 1);
+            for_each_index(Policy{}, p.n,
+                           detail::hash_particles<Real>{geometry_, p.x, p.user, tie_bits, key_.data(), order_.data()});
+            sort_by_key(ctx, key_.data(), order_.data(), p.n, tie_bits + bits_for(cells - 1));
+            // where each cell starts, for any number of empty cells (a tall box)
+            find_starts(ctx, key_.data(), tie_bits, p.n, cells, cell_start_.data());
+        }
         for_each_index(Policy{}, p.n, detail::gather<vec4<Real>>{p.x, order_.data(), sorted_x_});
     }
 
     grid_view<Real> view() const
     {
-        return {geometry_, key_.size(), order_.data(), sorted_x_, cell_start_.data()};
+        return {geometry_, n_, order_.data(), sorted_x_, cell_start_.data()};
     }
 
 private:
     grid_geometry<Real> geometry_;
-    buffer<unsigned long long, Policy> key_;
+    std::size_t n_ = 0;                      ///< particles of the last build
+    buffer<unsigned long long, Policy> key_; ///< sort keys (CUDA only)
     buffer<unsigned, Policy> order_, cell_start_;
     buffer<vec4<Real>, Policy> own_sorted_x_; ///< empty when the caller holds the sorted positions
     vec4<Real>* sorted_x_ = nullptr;
