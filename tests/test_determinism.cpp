@@ -320,6 +320,12 @@ TEMPLATE_TEST_CASE("the storage order does not change the physics: reordering on
         const auto a = record_of(sorted), b = record_of(unsorted);
         require_eventful(a);
         CHECK(sorted.rebuilds() > 2);
+        // positions() copies what snapshot().x holds, in user order, whatever the storage order.
+        for (const auto& [sim, snap_x] : {std::pair{&sorted, &a.snap.x}, std::pair{&unsorted, &b.snap.x}}) {
+            const auto x = sim->positions();
+            REQUIRE(x.size() == snap_x->size());
+            CHECK(std::memcmp(x.data(), snap_x->data(), x.size() * sizeof(x[0])) == 0);
+        }
         CHECK(sorted.walls().face[5].position != setup.first.box.hi.z); // the top wall moved
         const std::vector<std::string> diff = differences(a, b);
         INFO("fields that differ: " << Catch::Detail::stringify(diff));

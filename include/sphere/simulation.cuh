@@ -455,9 +455,9 @@ public:
         if (f % 2 == 0 ? !(position < opposite) : !(position > opposite))
             detail::fail("set_wall_position: face ", f, " at ", position, " m would cross the opposite wall at ",
                          opposite, " m");
-        const particle_snapshot<Coord> s = particles_.snapshot();
-        for (std::size_t i = 0; i < s.size(); ++i) {
-            const double x = double(s.position(i)[a]);
+        const std::vector<vec4<Coord>> at = particles_.positions();
+        for (std::size_t i = 0; i < at.size(); ++i) {
+            const double x = double(at[i].xyz()[a]);
             if (f % 2 == 0 ? x < position : x > position)
                 detail::fail("set_wall_position: particle ", i, " at ", x, " m on axis ", a, " would lie outside face ",
                              f, " at ", position, " m");
@@ -523,6 +523,9 @@ public:
 
     /// A host copy of every particle field, in user order.
     particle_snapshot<Coord> snapshot() const { return particles_.snapshot(); }
+    /// A host copy of the positions and radii alone (x, y, z, r in m), in user order: what
+    /// snapshot().x holds, without copying the other fields (an eighth of them in double).
+    std::vector<vec4<Coord>> positions() const { return particles_.positions(); }
     /// A host copy of the contact lists, in user order (forces only with settings.contact_forces).
     contact_table<Coord> contacts() const { return lists_.table(particles_.user_indices()); }
     /// Entries in the contact lists (each pair once, and each particle's wall entries).
@@ -1201,13 +1204,13 @@ private:
         if (pairs.fraction >= detail::deepest_overlap::coincident)
             detail::fail("particles ", pairs.i, " and ", pairs.j, " have the same centre: their contact has no normal");
         initial_overlap_ = pairs.fraction > initial_overlap_ ? pairs.fraction : initial_overlap_;
-        const particle_snapshot<Coord> snap = pairs.fraction > s.max_initial_overlap ? particles_.snapshot()
-                                                                                       : particle_snapshot<Coord>{};
-        if (pairs.fraction > s.max_initial_overlap)
-            detail::fail("particles ", pairs.i, " and ", pairs.j, " (radii ", snap.radius(pairs.i), " and ",
-                         snap.radius(pairs.j), " m) start overlapping by ", pairs.fraction,
+        if (pairs.fraction > s.max_initial_overlap) {
+            const std::vector<vec4<Coord>> at = particles_.positions();
+            detail::fail("particles ", pairs.i, " and ", pairs.j, " (radii ", at[pairs.i].w, " and ", at[pairs.j].w,
+                         " m) start overlapping by ", pairs.fraction,
                          " of the smaller radius, more than settings.max_initial_overlap = ", s.max_initial_overlap,
                          " (raise it to accept)");
+        }
     }
 
     /// Throws the error for particle i (a user index) at step `step`.

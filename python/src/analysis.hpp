@@ -48,7 +48,7 @@ void bind_analysis(py::module_& m)
             if (lo.is_none())
                 p = sphere::porosity_profile(sim, slices);
             else
-                p = sphere::porosity_profile(sim.snapshot().x, sim.config().box, point(lo, "lo"), point(hi, "hi"),
+                p = sphere::porosity_profile(sim.positions(), sim.config().box, point(lo, "lo"), point(hi, "hi"),
                                              slices);
             std::vector<double> z_lo(p.size()), z_hi(p.size()), phi(p.size());
             for (std::size_t k = 0; k < p.size(); ++k) {

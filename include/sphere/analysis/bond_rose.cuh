@@ -36,14 +36,14 @@ inline bond_orientation orientation_of(vec3<double> d)
 template <class Sim>
 std::vector<bond_orientation> bond_orientations(const Sim& sim)
 {
-    const auto snap = sim.snapshot();
+    const auto at = sim.positions();
     const auto bonds = sim.bonds();
     const auto& box = sim.config().box;
     std::vector<bond_orientation> out;
     for (std::size_t k = 0; k < bonds.size(); ++k)
         if (!bonds.broken[k])
-            out.push_back(orientation_of(vec_cast<double>(box.nearest_image_inside(snap.position(bonds.j[k]) -
-                                                                                    snap.position(bonds.i[k])))));
+            out.push_back(orientation_of(vec_cast<double>(box.nearest_image_inside(at[bonds.j[k]].xyz() -
+                                                                                    at[bonds.i[k]].xyz()))));
     return out;
 }
 

@@ -255,7 +255,7 @@ porosity_result bulk_porosity(const std::vector<vec4<Real>>& x, const world<Real
 template <class P, class Policy, class Law, class Integrator, class Real = coord_t<P>>
 porosity_result bulk_porosity(const simulation<P, Policy, Law, Integrator>& sim)
 {
-    return bulk_porosity(sim.snapshot().x, sim.config().box, sim.walls());
+    return bulk_porosity(sim.positions(), sim.config().box, sim.walls());
 }
 
 /// Porosity of a simulation's particles in the box [lo, hi] (m).
@@ -263,7 +263,7 @@ template <class P, class Policy, class Law, class Integrator, class Real = coord
 porosity_result bulk_porosity(const simulation<P, Policy, Law, Integrator>& sim, const vec3<double>& lo,
                               const vec3<double>& hi)
 {
-    return porosity_in_box(sim.snapshot().x, sim.config().box, lo, hi);
+    return porosity_in_box(sim.positions(), sim.config().box, lo, hi);
 }
 
 /// One horizontal slice of a porosity profile.
@@ -301,7 +301,7 @@ std::vector<porosity_slice> porosity_profile(const simulation<P, Policy, Law, In
 {
     vec3<double> lo, hi;
     detail::between_walls(sim.walls(), sim.config().box, lo, hi);
-    return porosity_profile(sim.snapshot().x, sim.config().box, lo, hi, slices);
+    return porosity_profile(sim.positions(), sim.config().box, lo, hi, slices);
 }
 
 } // namespace sphere

@@ -74,7 +74,7 @@ contact_snapshot<Real> take_contact_snapshot(const simulation<P, Policy, Law, In
     if (!sim.config().contact_forces)
         detail::fail("contact analyses need the contact forces: the simulation was set up with settings.contact_forces = false");
     contact_snapshot<Real> c;
-    c.x = sim.snapshot().x;
+    c.x = sim.positions();
     c.table = sim.contacts();
     c.box = sim.config().box;
     c.walls = sim.walls();

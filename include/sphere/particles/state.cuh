@@ -223,19 +223,16 @@ public:
     particle_snapshot<Coord> snapshot() const
     {
         const std::vector<unsigned> user = user_.to_host();
-        auto out = [&](const auto& field) {
-            const auto slots = field.to_host();
-            using T = decltype(widen(typename std::remove_reference_t<decltype(field)>::value_type{}));
-            std::vector<T> users(user.size(), T{}); // zeros for a field that is not kept
-            for (std::size_t k = 0; k < slots.size(); ++k) users[user[k]] = widen(slots[k]);
-            return users;
-        };
+        auto out = [&](const auto& field) { return in_user_order(field, user); };
         return {out(x_),     out(v_),      out(omega_),  out(distinct_sync_ ? v_sync_ : v_),
                 out(distinct_sync_ ? omega_sync_ : omega_),
                 out(angpos_), out(force_),  out(torque_), out(mass_),   out(pressure_),
                 out(e_visc_), out(e_fric_), out(p_visc_), out(p_fric_), out(kind_), out(material_),
                 out(displacement_)};
     }
+
+    /// A host copy of the positions and radii alone, in user order (what snapshot().x holds).
+    std::vector<vec4<Coord>> positions() const { return in_user_order(x_, user_.to_host()); }
 
     /// Replaces every field by a snapshot's, given in user order (for restarts and for
     /// host-side edits); the storage order stays.
@@ -279,6 +276,18 @@ private:
     static vec3<Coord> widen(const vec3<Coord>& a) { return a; }
     static Coord widen(Real a) { return Coord(a); }
     static std::uint8_t widen(std::uint8_t a) { return a; }
+
+    /// A host copy of `field` in user order (`user`: the user index of each slot), widened to
+    /// Coord; zeros for a field that is not kept.
+    template <class T>
+    static auto in_user_order(const buffer<T, Policy>& field, const std::vector<unsigned>& user)
+    {
+        const std::vector<T> slots = field.to_host();
+        std::vector<decltype(widen(T{}))> users(user.size(), decltype(widen(T{})){});
+        for (std::size_t k = 0; k < slots.size(); ++k) users[user[k]] = widen(slots[k]);
+        return users;
+    }
+
     template <class T> static T narrow(const vec4<Coord>& a) { return a; }
     template <class T> static T narrow(const vec3<Coord>& a)
     {

@@ -89,17 +89,17 @@ public:
         if (due <= inserted_) return 0;
         // The particles that may touch one in the region: the region grown by the largest
         // radius of either (a particle's reach), in the nearest image.
-        const auto snap = sim.snapshot();
+        const auto at = sim.positions();
         const auto& box = sim.config().box;
         std::vector<vec4<Real>> near;
         Real largest = 0;
-        for (std::size_t i = 0; i < snap.size(); ++i) largest = snap.x[i].w > largest ? snap.x[i].w : largest;
+        for (std::size_t i = 0; i < at.size(); ++i) largest = at[i].w > largest ? at[i].w : largest;
         const vec3<Real> middle = (s_.lo + s_.hi) * Real(0.5), half = (s_.hi - s_.lo) * Real(0.5);
-        for (std::size_t i = 0; i < snap.size(); ++i) {
-            const vec3<Real> d = box.nearest_image_inside(snap.position(i) - middle);
+        for (std::size_t i = 0; i < at.size(); ++i) {
+            const vec3<Real> d = box.nearest_image_inside(at[i].xyz() - middle);
             bool close = true;
             for (int a = 0; a < 3; ++a) close = close && std::fabs(d[a]) < half[a] + s_.radius_max + largest;
-            if (close) near.push_back(snap.x[i]);
+            if (close) near.push_back(at[i]);
         }
         std::vector<particle<Real>> added;
         for (std::size_t k = inserted_; k < due; ++k) {
