@@ -524,7 +524,7 @@ public:
     /// A host copy of every particle field, in user order.
     particle_snapshot<Coord> snapshot() const { return particles_.snapshot(); }
     /// A host copy of the positions and radii alone (x, y, z, r in m), in user order: what
-    /// snapshot().x holds, without copying the other fields (an eighth of them in double).
+    /// snapshot().x holds, an eighth of a full snapshot's bytes in double.
     std::vector<vec4<Coord>> positions() const { return particles_.positions(); }
     /// A host copy of the contact lists, in user order (forces only with settings.contact_forces).
     contact_table<Coord> contacts() const { return lists_.table(particles_.user_indices()); }
