@@ -841,6 +841,19 @@ TEMPLATE_TEST_CASE("every cell's start is the number of particles in lower cells
     grid.build(context, p);
     for (std::size_t k = 1; k < n; ++k)
         if (g.cell_of(x[v.order[k - 1]].xyz()) == g.cell_of(x[v.order[k]].xyz())) CHECK(v.order[k - 1] < v.order[k]);
+    // One cell for the whole box (cells as wide as the box): the order is the user indices'
+    // alone, n - 1 .. 0 down the slots.
+    const auto one = sphere::grid_geometry<Real>::make(box, Real(0.001), Real(2.0));
+    REQUIRE(one.cell_count() == 1u);
+    p.user = user.data();
+    sphere::neighbor_grid<Real, sphere::host> whole(one);
+    whole.build(context, p);
+    const sphere::grid_view<Real> w = whole.view();
+    CHECK(w.cell_start[0] == 0);
+    CHECK(w.cell_start[1] == n);
+    std::size_t misplaced = 0;
+    for (std::size_t k = 0; k < n; ++k) misplaced += w.order[k] != n - 1 - k;
+    CHECK(misplaced == 0);
 }
 
 TEMPLATE_TEST_CASE("contact lists give histories to their near rows only, until a step must walk the far rows",
