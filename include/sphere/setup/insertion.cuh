@@ -92,8 +92,7 @@ public:
         const auto at = sim.positions();
         const auto& box = sim.config().box;
         std::vector<vec4<Real>> near;
-        Real largest = 0;
-        for (std::size_t i = 0; i < at.size(); ++i) largest = at[i].w > largest ? at[i].w : largest;
+        const Real largest = sim.largest_radius();
         const vec3<Real> middle = (s_.lo + s_.hi) * Real(0.5), half = (s_.hi - s_.lo) * Real(0.5);
         for (std::size_t i = 0; i < at.size(); ++i) {
             const vec3<Real> d = box.nearest_image_inside(at[i].xyz() - middle);
