@@ -227,7 +227,7 @@ struct simulation_state {
     particle_snapshot<Real> particles;  ///< in user order
     contact_table<Real> contacts;        ///< the contact lists and their history (forces left out)
     bond_table<Real> bonds;              ///< the bonds and their state
-    std::vector<vec4<Real>> x_at_build; ///< positions when the lists were built, in user order
+    std::vector<vec4<Real>> x_at_build; ///< positions (xyz) and radii (w) when the lists were built, in user order
     std::vector<unsigned> storage;       ///< the user index of each storage slot (the storage order)
     wall_set<Real> walls;
     wall_set<Real> walls_at_build; ///< the walls when the lists were built
@@ -632,10 +632,15 @@ public:
         const std::vector<unsigned> user = particles_.user_indices();
         contact_table<Coord> contacts = lists_.table(user);
         contacts.force.clear();
-        std::vector<vec4<Coord>> slots = x_at_build_.to_host(), x_at_build(slots.size());
-        for (std::size_t k = 0; k < slots.size(); ++k) x_at_build[user[k]] = slots[k];
         simulation_state<Coord> st;
         st.particles = particles_.snapshot();
+        // the positions at the last rebuild with the radii (which they were built with)
+        const std::vector<vec3<Coord>> slots = x_at_build_.to_host();
+        std::vector<vec4<Coord>> x_at_build(slots.size());
+        for (std::size_t k = 0; k < slots.size(); ++k) {
+            const vec3<Coord>& a = slots[k];
+            x_at_build[user[k]] = {a.x, a.y, a.z, st.particles.x[user[k]].w};
+        }
         st.contacts = std::move(contacts);
         st.bonds = bonds_.table();
         st.x_at_build = std::move(x_at_build);
@@ -691,10 +696,10 @@ public:
         }
         check_bond_table(s.bonds);
         const stream_scope<Policy> on_stream(context_);
-        // The ranks of the last rebuild follow from its positions and the user indices: the
-        // grid over those positions, in user order. The particles go back into rank order
-        // (or stay in user order without settings.reorder), whatever order the state was
-        // saved in.
+        // The ranks of the last rebuild follow from its positions and the user indices: a grid
+        // over those positions, in user order (held for the restore alone). The particles go
+        // back into rank order (or stay in user order without settings.reorder), whatever
+        // order the state was saved in.
         std::vector<unsigned> identity(size());
         for (std::size_t i = 0; i < size(); ++i) identity[i] = static_cast<unsigned>(i);
         buffer<vec4<Coord>, Policy> x_build;
@@ -705,8 +710,9 @@ public:
         at_build.n = size();
         at_build.x = x_build.data();
         at_build.user = users.data();
-        grid_.build(context_, at_build, x_at_build_.data()); // set below
-        const grid_view<Coord> g = grid_.view();
+        neighbor_grid<Coord, Policy> grid_at_build(grid_.geometry());
+        grid_at_build.build(context_, at_build);
+        const grid_view<Coord> g = grid_at_build.view();
         const std::vector<unsigned> before = particles_.user_indices();
         std::vector<unsigned> storage = identity;
         if (settings_.reorder) {
@@ -732,8 +738,8 @@ public:
         fresh.lists.near_entries = unsigned(lists_.near_entries());
         fresh.lists.wall_particles = unsigned(wall_launch_);
         report_.assign(std::vector<detail::step_report<Coord>>{fresh});
-        std::vector<vec4<Coord>> slots(size());
-        for (std::size_t k = 0; k < size(); ++k) slots[k] = s.x_at_build[storage[k]];
+        std::vector<vec3<Coord>> slots(size());
+        for (std::size_t k = 0; k < size(); ++k) slots[k] = s.x_at_build[storage[k]].xyz();
         x_at_build_.assign(slots);
         if (external_.size()) { // external forces follow their particles into the new slots
             const std::vector<vec3<Real>> old = external_.to_host();
@@ -832,20 +838,23 @@ private:
     /// settle_rebuild() takes them once read back.
     void rebuild_lists(list_totals* totals)
     {
-        // The positions of this rebuild in rank order go straight into x_at_build_: the lists
-        // are built from them, and once the particles are stored in rank order they are the
-        // positions at the rebuild of each slot.
-        grid_.build(context_, particles_.view(), x_at_build_.data());
-        const grid_view<Coord> g = grid_.view();
-        lists_.rebuild(context_, g, walls_, settings_.skin + range_, near_skin() + range_, !settings_.reorder, totals);
-        interaction_.lists_changed();
+        // The lists are built from the positions of this rebuild in rank order: with
+        // settings.reorder the particles' own, once permuted into that order (by way of
+        // x_at_build_, which then holds them as the positions at the rebuild of each slot);
+        // without it a copy that the grid gathers.
+        const particle_view<Precision> p = particles_.view();
         if (settings_.reorder) {
-            particles_.permute(g.order, x_at_build_.data(), external_);
-            bonds_.locate(particles_.view());
+            grid_.order(context_, p);
+            particles_.permute(grid_.view().order, x_at_build_.data(), external_);
+            grid_.sorted(p.x);
+            bonds_.locate(p);
         } else {
-            const particle_view<Precision> p = particles_.view();
-            for_each_index(Policy{}, p.n, detail::copy_back<vec4<Coord>>{p.x, x_at_build_.data()});
+            grid_.build(context_, p);
+            for_each_index(Policy{}, p.n, detail::position_part<Coord>{p.x, x_at_build_.data()});
         }
+        lists_.rebuild(context_, grid_.view(), walls_, settings_.skin + range_, near_skin() + range_, !settings_.reorder,
+                       totals);
+        interaction_.lists_changed();
         wall_launch_ = size(); // the wall particles are known once the totals are read back
     }
 
@@ -1371,7 +1380,7 @@ private:
     contact_lists<Precision, Policy> lists_;
     interaction<Precision, Policy> interaction_;
     pair_summation summation_ = pair_summation::slabs; ///< settings_.pair_summation, resolved for the backend
-    buffer<vec4<Coord>, Policy> x_at_build_;
+    buffer<vec3<Coord>, Policy> x_at_build_; ///< positions at the last rebuild of each slot
     execution_context<Policy> context_;
     buffer<detail::step_report<Coord>, Policy> report_; ///< one, written by the step's reductions
     wall_set<Coord> walls_at_build_;      ///< the walls when the lists were built

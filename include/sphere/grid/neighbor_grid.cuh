@@ -82,25 +82,31 @@ public:
     const grid_geometry<Real>& geometry() const { return geometry_; }
 
     /// Rebuilds the cell lists from the particles' current positions (held in Real: a grid
-    /// is laid in the type of the positions, coord_t of the particles' precision P). The
-    /// positions in sorted order go to `sorted_into` (p.n elements of policy memory that the
-    /// caller owns and keeps unchanged while it uses the view) or, without it, to the grid's
-    /// own array. No allocation once the particle count and the caller's array stay (CUDA sorts
-    /// and scans through `ctx`'s scratch; the host needs none).
+    /// is laid in the type of the positions, coord_t of the particles' precision P) and
+    /// gathers the positions in sorted order into the grid's own array. No allocation once the
+    /// particle count stays.
     template <class P>
-    void build(execution_context<Policy>& ctx, const particle_view<P>& p, vec4<Real>* sorted_into = nullptr)
+    void build(execution_context<Policy>& ctx, const particle_view<P>& p)
+    {
+        order(ctx, p);
+        if (own_sorted_x_.size() != p.n) own_sorted_x_.resize(p.n);
+        for_each_index(Policy{}, p.n, detail::gather<vec4<Real>>{p.x, order_.data(), own_sorted_x_.data()});
+        sorted_x_ = own_sorted_x_.data();
+    }
+
+    /// Rebuilds the cell lists like build() but leaves the positions where they are: the
+    /// caller moves them into the grid's order (e.g. particle_state::permute) and hands them
+    /// to sorted() before it reads the view's positions; the grid's own array is freed. No
+    /// allocation once the particle count stays (CUDA sorts and scans through `ctx`'s scratch;
+    /// the host needs none).
+    template <class P>
+    void order(execution_context<Policy>& ctx, const particle_view<P>& p)
     {
         static_assert(std::is_same_v<coord_t<P>, Real>, "the grid is laid in the type of the positions");
         const std::size_t cells = geometry_.cell_count();
         n_ = p.n;
+        sorted_x_ = nullptr;
         if (order_.size() != p.n) order_.resize(p.n);
-        if (sorted_into) {
-            if (own_sorted_x_.size()) own_sorted_x_ = buffer<vec4<Real>, Policy>();
-            sorted_x_ = sorted_into;
-        } else {
-            if (own_sorted_x_.size() != p.n) own_sorted_x_.resize(p.n);
-            sorted_x_ = own_sorted_x_.data();
-        }
         if (cell_start_.size() != cells + 1) cell_start_.resize(cells + 1);
         if constexpr (runs_in_blocks<Policy>) { // host memory, read and written in place
             detail::order_by_cell(geometry_, p.x, p.user, p.n, order_.data(), cell_start_.data());
@@ -113,7 +119,14 @@ public:
             // where each cell starts, for any number of empty cells (a tall box)
             find_starts(ctx, key_.data(), tie_bits, p.n, cells, cell_start_.data());
         }
-        for_each_index(Policy{}, p.n, detail::gather<vec4<Real>>{p.x, order_.data(), sorted_x_});
+    }
+
+    /// The positions and radii in the order of the last order() (p.n elements of policy
+    /// memory that the caller keeps unchanged while it uses the view); frees the grid's own.
+    void sorted(const vec4<Real>* sorted_x)
+    {
+        if (own_sorted_x_.size()) own_sorted_x_ = buffer<vec4<Real>, Policy>();
+        sorted_x_ = sorted_x;
     }
 
     grid_view<Real> view() const
@@ -127,7 +140,7 @@ private:
     buffer<unsigned long long, Policy> key_; ///< sort keys (CUDA only)
     buffer<unsigned, Policy> order_, cell_start_;
     buffer<vec4<Real>, Policy> own_sorted_x_; ///< empty when the caller holds the sorted positions
-    vec4<Real>* sorted_x_ = nullptr;
+    const vec4<Real>* sorted_x_ = nullptr;
 };
 
 } // namespace sphere

@@ -189,7 +189,7 @@ template <class P>
 struct check_particle {
     using Coord = coord_t<P>;
     particle_view<P> p;
-    const vec4<Coord>* x_at_build;
+    const vec3<Coord>* x_at_build;
     world<Coord> box;
     wall_set<Coord> walls;
 
@@ -215,7 +215,7 @@ struct check_particle {
         // cannot load fields conditionally in SIMD lanes): a NaN becomes +infinity, and a bad
         // particle's +infinity wins the maximum.
         const Coord inf = infinity<Coord>;
-        Coord moved = norm2(box.nearest_image_inside(pos - x_at_build[i].xyz())); // both wrapped
+        Coord moved = norm2(box.nearest_image_inside(pos - x_at_build[i])); // both wrapped
         moved = moved == moved ? moved : inf;
         const Coord flag = bad_at(i, pos) ? inf : Coord(0);
         return moved > flag ? moved : flag;

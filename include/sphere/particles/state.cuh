@@ -71,6 +71,39 @@ struct scatter {
     SPHERE_HD void operator()(std::size_t k) const { to[order[k]] = from[k]; }
 };
 
+/// The position and radius of slot order[k] into xyz[k] and radius[k] (Gather, like gather),
+/// or those of slot k into xyz[order[k]] and radius[order[k]] (like scatter).
+template <class Coord, bool Gather>
+struct split_position {
+    const vec4<Coord>* x;
+    const unsigned* order;
+    vec3<Coord>* xyz;
+    Coord* radius;
+    SPHERE_HD void operator()(std::size_t k) const
+    {
+        const std::size_t from = Gather ? order[k] : k, to = Gather ? k : order[k];
+        xyz[to] = x[from].xyz();
+        radius[to] = x[from].w;
+    }
+};
+
+/// xyz[k] = the position of x[k] (its radius left out).
+template <class Coord>
+struct position_part {
+    const vec4<Coord>* x;
+    vec3<Coord>* xyz;
+    SPHERE_HD void operator()(std::size_t k) const { xyz[k] = x[k].xyz(); }
+};
+
+/// x[k] = (xyz[k], radius[k]).
+template <class Coord>
+struct join_position {
+    const vec3<Coord>* xyz;
+    const Coord* radius;
+    vec4<Coord>* x;
+    SPHERE_HD void operator()(std::size_t k) const { x[k] = {xyz[k].x, xyz[k].y, xyz[k].z, radius[k]}; }
+};
+
 /// to[k] = from[k] (kernel body of a copy).
 template <class T>
 struct copy_back {
@@ -195,23 +228,24 @@ public:
 
     /// Moves the particle in slot order[k] to slot k, for every k (order is a permutation),
     /// and with it every array in `along` that must stay in step with the particles (e.g.
-    /// external forces; an empty one stays empty); `sorted_x` holds the positions and radii
-    /// already in that order. The forces are not carried (the next force evaluation writes
-    /// them): their array is the permutation's scratch and holds zeros afterwards.
+    /// external forces; an empty one stays empty). The positions go by way of `xyz` (n
+    /// elements of policy memory, which hold them in the new order afterwards) and the radii
+    /// by way of the forces' array. The forces are not carried (the next force evaluation
+    /// writes them): their array is the permutation's scratch and holds zeros afterwards.
     template <class... Along>
-    void permute(const unsigned* order, const vec4<Coord>* sorted_x, Along&... along)
+    void permute(const unsigned* order, vec3<Coord>* xyz, Along&... along)
     {
-        for_each_index(Policy{}, x_.size(), detail::copy_back<vec4<Coord>>{sorted_x, x_.data()});
+        move_positions<detail::gather>(order, xyz);
         move_fields<detail::gather>(order, along...);
     }
 
-    /// Undoes permute(order, sorted_x, along...): every particle and `along` array back into
-    /// the slot it had before; `sorted_x` still holds the positions in the permuted order (the
-    /// forces, scratch, are left zero). Every array keeps its address.
+    /// Undoes permute(order, xyz, along...): every particle and `along` array back into the
+    /// slot it had before (`xyz` then holds the positions in those slots; the forces, scratch,
+    /// are left zero). Every array keeps its address.
     template <class... Along>
-    void unpermute(const unsigned* order, const vec4<Coord>* sorted_x, Along&... along)
+    void unpermute(const unsigned* order, vec3<Coord>* xyz, Along&... along)
     {
-        for_each_index(Policy{}, x_.size(), detail::scatter<vec4<Coord>>{sorted_x, order, x_.data()});
+        move_positions<detail::scatter>(order, xyz);
         move_fields<detail::scatter>(order, along...);
     }
 
@@ -317,6 +351,21 @@ private:
         move_field<Move>(user_, order);
         (move_field<Move>(along, order), ...);
         for_each_index(Policy{}, force_.size(), detail::fill_value<vec3<Real>>{force_.data(), {0, 0, 0}});
+    }
+
+    /// Moves the positions through `order` by `Move` into `xyz` and the radii into the forces'
+    /// array, and joins them back in x_.
+    template <template <class> class Move>
+    void move_positions(const unsigned* order, vec3<Coord>* xyz)
+    {
+        // A radius fits in a force's place, and buffers start at least 16-B aligned (operator
+        // new, cudaMalloc): a double is aligned in the forces' array of mixed precision too.
+        static_assert(sizeof(Coord) <= sizeof(vec3<Real>) && alignof(Coord) <= 16, "a radius fits in a force's place");
+        Coord* radius = reinterpret_cast<Coord*>(force_.data());
+        const std::size_t n = x_.size();
+        constexpr bool gathers = std::is_same_v<Move<Coord>, detail::gather<Coord>>;
+        for_each_index(Policy{}, n, detail::split_position<Coord, gathers>{x_.data(), order, xyz, radius});
+        for_each_index(Policy{}, n, detail::join_position<Coord>{xyz, radius, x_.data()});
     }
 
     /// Moves one field through `order` by `Move` into the forces' array (for the accumulated
