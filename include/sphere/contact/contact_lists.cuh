@@ -432,6 +432,13 @@ struct record_totals {
     }
 };
 
+/// Whether row r of the near rows at `offset` has wall entries (they end it).
+SPHERE_HDI bool row_has_walls(const unsigned* offset, const unsigned* partner, std::size_t r)
+{
+    const unsigned end = offset[r + 1];
+    return end > offset[r] && partner[end - 1] >= wall_partner_base;
+}
+
 /// Whether rank r has wall entries (1 or 0), for the list of such ranks.
 struct has_walls {
     const unsigned* offset;
@@ -440,8 +447,7 @@ struct has_walls {
     unsigned* flag;
     SPHERE_HD void operator()(std::size_t r) const
     {
-        const unsigned end = offset[r + 1];
-        flag[r] = !totals->overflow && end > offset[r] && partner[end - 1] >= wall_partner_base ? 1u : 0u;
+        flag[r] = !totals->overflow && row_has_walls(offset, partner, r) ? 1u : 0u;
     }
 };
 
@@ -501,7 +507,7 @@ public:
     /// Empty lists for n particles whose histories have `shape` (the contact law's,
     /// contact/history.cuh); `record_forces` keeps each entry's force of the last step.
     contact_lists(std::size_t n, bool record_forces, history_shape shape = {})
-        : record_forces_(record_forces), offset_(2 * n + 1, 0u), next_offset_(2 * n + 1, 0u), history_(shape),
+        : record_forces_(record_forces), offset_(2 * n + 1, 0u), history_(shape),
           kept_offset_(n + 1, 0u), kept_history_(shape), wall_ranks_(n, no_rank)
     {
     }
@@ -550,8 +556,16 @@ public:
         const std::size_t n = size();
         if (!histories_kept_) keep_histories(ctx);
         histories_kept_ = true;
+        // The new rows are counted beside the old ones where the kept entries may not have
+        // held the old histories (settle() then puts the old lists back in use): always on
+        // CUDA, which does not wait to learn it, on the host only when they did not hold them
+        // (it knows at once), so that the host keeps no second row offsets between rebuilds.
+        bool beside = true;
+        if constexpr (runs_in_blocks<Policy>) beside = kept_offset_.data()[n] > kept_capacity();
+        if (beside && next_offset_.size() != 2 * n + 1) next_offset_.resize(2 * n + 1);
         const detail::neighbour_scan<Coord> scan{grid, walls, skin, near_skin};
-        unsigned* offset = next_offset_.data(); // the near rows' lengths, then the far rows'
+        // the near rows' lengths, then the far rows'
+        unsigned* offset = beside ? next_offset_.data() : offset_.data();
         for_each_index(Policy{}, n, detail::count_entries<Coord>{scan, offset});
         for_each_index(Policy{}, 1, detail::fill_value<unsigned>{offset + 2 * n, 0u});
         exclusive_scan(ctx, offset, 2 * n + 1);
@@ -575,7 +589,7 @@ public:
             for_each_index(Policy{}, n,
                            detail::set_rank_slots{grid.order, totals, slot_of_rank_.data(), rank_of_slot_.data()});
         }
-        offset_.swap(next_offset_);
+        if (beside) offset_.swap(next_offset_);
         keep_order_ = keep_order;
         old_far_history_ = far_history_;
         far_history_ = false;
@@ -630,6 +644,7 @@ public:
         ++overflows_;
         if (t.kept > kept_capacity()) {
             offset_.swap(next_offset_); // the old lists are whole: their histories were not copied
+            if constexpr (runs_in_blocks<Policy>) next_offset_ = buffer<unsigned, Policy>(); // see rebuild()
             far_history_ = old_far_history_;
             histories_kept_ = false;
         }
@@ -783,7 +798,7 @@ public:
         std::vector<unsigned> wall_ranks(n, no_rank);
         std::size_t with_walls = 0;
         for (std::size_t r = 0; r < n; ++r)
-            if (off[r + 1] > off[r] && part[off[r + 1] - 1] >= wall_partner_base) wall_ranks[with_walls++] = unsigned(r);
+            if (detail::row_has_walls(off.data(), part.data(), r)) wall_ranks[with_walls++] = unsigned(r);
         near_entries_ = part.size();
         for (std::size_t r = 0; r <= n; ++r) off[n + r] = static_cast<unsigned>(near_entries_ + far_rows[r]);
         part.insert(part.end(), far_part.begin(), far_part.end());
@@ -836,6 +851,16 @@ private:
     void set_wall_ranks(execution_context<Policy>& ctx, const unsigned* offset, list_totals* totals)
     {
         const std::size_t n = size();
+        if constexpr (runs_in_blocks<Policy>) { // host memory: in one pass, without the scan's array
+            unsigned* ranks = wall_ranks_.data();
+            std::size_t with = 0;
+            if (!totals->overflow)
+                for (std::size_t r = 0; r < n; ++r)
+                    if (detail::row_has_walls(offset, partner_.data(), r)) ranks[with++] = static_cast<unsigned>(r);
+            std::fill(ranks + with, ranks + n, no_rank);
+            totals->wall_particles = static_cast<unsigned>(with);
+            return;
+        }
         if (wall_place_.size() != n + 1) wall_place_.resize(n + 1);
         unsigned* place = wall_place_.data();
         for_each_index(Policy{}, n, detail::has_walls{offset, partner_.data(), totals, place});
@@ -879,7 +904,9 @@ private:
     bool old_far_history_ = false; ///< far_history_ of the lists before the last rebuild
     std::size_t entries_ = 0, near_entries_ = 0, overflows_ = 0;
     buffer<unsigned, Policy> offset_;      ///< the near rows, then the far rows (contact_view::offset)
-    buffer<unsigned, Policy> next_offset_; ///< the rows a rebuild counts (then swapped with offset_)
+    /// the rows a rebuild counts beside offset_ (then swaps with it); on the host only while
+    /// the old lists' histories did not fit the kept entries (rebuild())
+    buffer<unsigned, Policy> next_offset_;
     buffer<unsigned, Policy> partner_;     ///< capacity() entries
     history_store<Real, Policy> history_;  ///< history_capacity() entries
     buffer<vec4<Real>, Policy> force_;     ///< history_capacity() entries when recorded
@@ -888,7 +915,8 @@ private:
     buffer<unsigned, Policy> kept_offset_, kept_partner_;
     history_store<Real, Policy> kept_history_;
     buffer<unsigned, Policy> slot_of_rank_, rank_of_slot_; ///< only with keep_order
-    buffer<unsigned, Policy> wall_ranks_, wall_place_;
+    buffer<unsigned, Policy> wall_ranks_;
+    buffer<unsigned, Policy> wall_place_; ///< the scan that places wall_ranks_ (CUDA only)
     std::size_t wall_particles_ = 0;
     std::vector<unsigned> layer_start_, layer_entries_;
 };
