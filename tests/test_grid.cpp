@@ -9,6 +9,10 @@
 //    every pair that overlaps is listed in the step that evaluates it.
 // 3. The tangential history of a contact is keyed by the partner's index: it survives
 //    rebuilds that insert and remove other partners in front of it.
+// 4. Reference positions (boundary/position_lattice.cuh): lattice points that encode to
+//    themselves, within half a step of any position in the box, in the position's grid cell;
+//    worlds the lattice cannot cover are refused; and the two margins they need (a pair that
+//    touches is a near pair, a displacement counts the rounding) each fail without it.
 #include <catch2/catch.hpp>
 
 #include "support.hpp"
@@ -826,9 +830,9 @@ TEMPLATE_TEST_CASE("every cell's start is the number of particles in lower cells
     // the slots, so the order within a cell is the ties' and not the slots').
     std::size_t shared = 0; // pairs of particles in one cell
     for (std::size_t k = 0; k < n; ++k) {
-        CHECK(v.sorted_x[k].z == x[v.order[k]].z);
+        CHECK(v.sorted_x.x[k].z == x[v.order[k]].z);
         if (k == 0) continue;
-        const unsigned before = g.cell_of(v.sorted_x[k - 1].xyz()), here = g.cell_of(v.sorted_x[k].xyz());
+        const unsigned before = g.cell_of(v.sorted_x.x[k - 1].xyz()), here = g.cell_of(v.sorted_x.x[k].xyz());
         CHECK(before <= here);
         if (before == here) {
             ++shared;
@@ -909,6 +913,207 @@ TEMPLATE_TEST_CASE("contact lists give histories to their near rows only, until 
     rebuild(); // new lists: their far rows have no histories again; the arrays keep their size
     CHECK_FALSE(lists.far_histories());
     CHECK(lists.history_capacity() >= 5);
+}
+
+TEST_CASE("reference positions lie on a lattice whose points encode to themselves and which covers the world", "[grid]")
+{
+    struct box_case {
+        const char* name;
+        vec3<double> lo, hi;
+    };
+    const box_case boxes[] = {{"a unit box at the origin", {0, 0, 0}, {1, 1, 1}},
+                              {"a box around the origin", {-0.2, -0.3, -0.1}, {0.2, 0.3, 0.5}},
+                              {"a box far from the origin", {1000, -5e4, 7}, {1000.4, -4.9999e4, 7.001}},
+                              {"a box whose lengths are powers of two", {0, 0, 0}, {0.25, 4, 1024}}};
+    constexpr double last = 4294967295.0; // the last point's number of steps, 2^32 - 1
+    std::mt19937_64 rng(42);
+    std::uniform_real_distribution<double> u(0, 1);
+    for (const box_case& c : boxes)
+        DYNAMIC_SECTION(c.name)
+        {
+            sphere::world<double> box;
+            box.lo = c.lo;
+            box.hi = c.hi;
+            const sphere::position_lattice<double> l = sphere::position_lattice<double>::over(box);
+            for (int a = 0; a < 3; ++a) {
+                const double length = box.hi[a] - box.lo[a], step = l.step[a];
+                int e = 0;
+                CHECK(std::frexp(step, &e) == 0.5);  // a power of two
+                CHECK(step * (last - 1) >= length);   // 2^32 - 2 steps span the box
+                CHECK(step * (last - 1) < 2 * length); // and no coarser than that needs
+                CHECK(l.origin[a] <= box.lo[a]);
+                CHECK(l.origin[a] > box.lo[a] - step);
+                CHECK(l.origin[a] + last * step >= box.hi[a]);
+            }
+            // Any position in the box: its point lies within half a step (and the round-off of
+            // its distance to the origin) on each axis, and encodes to itself.
+            std::size_t far = 0, moved = 0;
+            for (int k = 0; k < 100000; ++k) {
+                vec3<double> x;
+                for (int a = 0; a < 3; ++a) x[a] = k == 0 ? box.lo[a] : (k == 1 ? box.hi[a] : box.lo[a] + u(rng) * (box.hi[a] - box.lo[a]));
+                const sphere::lattice_point q = l.encode(x);
+                const vec3<double> at = l.decode(q);
+                for (int a = 0; a < 3; ++a)
+                    if (std::fabs(at[a] - x[a]) > 0.5 * l.step[a] + 2 * std::numeric_limits<double>::epsilon() * std::fabs(x[a]))
+                        ++far;
+                const sphere::lattice_point back = l.encode(at);
+                moved += back.x != q.x || back.y != q.y || back.z != q.z;
+            }
+            CHECK(far == 0);
+            CHECK(moved == 0);
+            // the lattice's ends and middle encode to themselves
+            for (const std::uint32_t n : {0u, 1u, 2147483648u, 4294967294u, 4294967295u}) {
+                const sphere::lattice_point back = l.encode(l.decode({n, n, n}));
+                CHECK((back.x == n && back.y == n && back.z == n));
+            }
+            // positions beyond the lattice clamp to its ends, a NaN to its first point
+            const vec3<double> length = box.hi - box.lo;
+            const sphere::lattice_point below = l.encode(box.lo - length * 10.0), above = l.encode(box.hi + length * 10.0),
+                                        nan = l.encode({std::nan(""), std::nan(""), std::nan("")});
+            CHECK((below.x == 0u && below.y == 0u && below.z == 0u));
+            CHECK((above.x == 4294967295u && above.y == 4294967295u && above.z == 4294967295u));
+            CHECK((nan.x == 0u && nan.y == 0u && nan.z == 0u));
+        }
+    // float positions are stored as they are
+    static_assert(std::is_same_v<sphere::position_lattice<float>::stored, vec3<float>>);
+    const sphere::position_lattice<float> f = sphere::position_lattice<float>::over(sphere::world<float>{});
+    const vec3<float> x{0.1f, 0.7f, 0.3f};
+    CHECK(f.decode(f.encode(x)) == x);
+}
+
+TEST_CASE("a world that the reference positions' lattice cannot cover exactly is refused, with the axis", "[grid][errors]")
+{
+    sphere::world<double> flat;
+    flat.hi = {1, 1, 1};
+    flat.lo = {0, 1, 0};
+    REQUIRE_THROWS_WITH(sphere::position_lattice<double>::over(flat),
+                        Catch::Contains("the world's axis 1 from 1 to 1 m has no finite length"));
+    // a millimetre at 10^9 m: its steps (2^-41 m) number about 2^71 from the origin
+    sphere::world<double> far;
+    far.lo = {0, 0, 1e9};
+    far.hi = {1, 1, 1e9 + 1e-3};
+    REQUIRE_THROWS_WITH(sphere::position_lattice<double>::over(far),
+                        Catch::Contains("the world's axis 2 from 1000000000 to 1000000000.001 m lies too far from the origin"));
+    // a simulation in such a world: 0.25 m at 10^9 m (steps of 2^-33 m, 2^63 of them from the origin)
+    sphere::settings<double> s = sphere_test::box_settings<double>();
+    s.box.lo.z = 1e9;
+    s.box.hi.z = 1e9 + 0.25;
+    REQUIRE_THROWS_WITH(sphere::simulation<double>(s, {sphere_test::ball<double>({0, 0, 1e9 + 0.125})}),
+                        Catch::Contains("the world's axis 2 from 1000000000 to 1000000000.25 m lies too far from the origin"));
+}
+
+TEMPLATE_TEST_CASE("the positions of the last rebuild are lattice points near the particles", "[grid]", double,
+                   sphere::mixed)
+{
+    using P = TestType;
+    using Real = sphere_test::user_real<P>;
+    sphere::settings<Real> s = sphere_test::box_settings<Real>();
+    s.box = cloud_box<Real>(true, false);
+    s.skin = Real(0.3 * r0);
+    s.max_initial_overlap = std::numeric_limits<Real>::infinity();
+    sphere::simulation<P> sim(s, random_cloud<Real>(s.box, 7));
+    const sphere::position_lattice<double> l = sphere::position_lattice<double>::over(s.box);
+    const sphere::simulation_state<Real> st = sim.state();
+    const sphere::particle_snapshot<Real> snap = sim.snapshot();
+    std::size_t off_lattice = 0, far = 0;
+    for (std::size_t i = 0; i < snap.size(); ++i) {
+        const vec3<double> at = st.x_at_build[i].xyz();
+        off_lattice += !(l.decode(l.encode(at)) == at);
+        for (int a = 0; a < 3; ++a)
+            far += std::fabs(at[a] - snap.x[i].xyz()[a]) > 0.5 * l.step[a] * (1 + 1e-6);
+        CHECK(st.x_at_build[i].w == snap.x[i].w);
+    }
+    CHECK(off_lattice == 0);
+    CHECK(far == 0);
+}
+
+TEMPLATE_TEST_CASE("a pair that touches at a rebuild is a near pair, also where its reference positions lie apart",
+                   "[grid][contacts]", double, sphere::mixed)
+{
+    using P = TestType;
+    using Real = sphere_test::user_real<P>;
+    sphere::settings<Real> s = sphere_test::box_settings<Real>();
+    s.skin = 0; // every step rebuilds and walks the near rows alone
+    s.max_initial_overlap = std::numeric_limits<Real>::infinity();
+    const sphere::position_lattice<double> l = sphere::position_lattice<double>::over(s.box);
+    const double step = l.step.x, apart = double(1 << 24); // 2^24 steps of 2^-34 m: about 1 mm
+    // A 0.49 steps above a lattice point (its reference position rounds down), B 0.51 steps
+    // above another (it rounds up), 1e-13 m closer than their radii: they touch, and their
+    // reference positions lie 0.98 steps farther apart than the particles, beyond the radii.
+    const vec3<double> o = l.decode({2147483648u, 2147483648u, 2147483648u});
+    const vec3<double> a{o.x + 0.49 * step, o.y, o.z}, b{o.x + (apart + 0.51) * step, o.y, o.z};
+    const double r = (b.x - a.x + 1e-13) / 2;
+    REQUIRE(l.decode(l.encode(b)).x - l.decode(l.encode(a)).x > 2 * r);
+    sphere::simulation<P> sim(s, {sphere_test::ball<Real>(a, {0, 0, 0}, Real(r)), sphere_test::ball<Real>(b, {0, 0, 0}, Real(r))});
+    REQUIRE(sim.contacts().partners_of(0).size() == 1);
+    // The steps after the first rebuild and walk the near rows alone: they find the contact
+    // (without the near rows' margin its force was zero from the second step on).
+    for (int k = 0; k < 3; ++k) sim.step();
+    CHECK(sim.rebuilds() == 3);
+    CHECK(sim.near_walks() == 2);
+    const sphere::particle_snapshot<Real> snap = sim.snapshot();
+    CHECK(snap.force[0].x < 0);
+    CHECK(snap.force[1].x > 0);
+}
+
+TEST_CASE("reference positions place every particle in the grid cell of its position", "[grid]")
+{
+    sphere::world<double> box;
+    box.lo = {-0.13, 0.05, -0.2};
+    box.hi = {0.23, 0.35, 0.13};
+    box.axis[0] = boundary::periodic;
+    const sphere::grid_geometry<double> g = sphere::grid_geometry<double>::make(box, 0.031, 0);
+    const sphere::position_lattice<double> l = sphere::position_lattice<double>::over(box);
+    std::mt19937_64 rng(3);
+    std::uniform_real_distribution<double> u(0, 1);
+    // positions a fraction of a step from a cell face (and at random elsewhere)
+    const double offsets[] = {-1.5, -0.51, -0.49, -0.2, 0.0, 0.2, 0.49, 0.51, 1.5};
+    std::size_t moved = 0, other_cell = 0, far = 0, tried = 0;
+    for (int a = 0; a < 3; ++a)
+        for (unsigned c = 1; c < g.n[a]; ++c)
+            for (const double t : offsets) {
+                vec3<double> x;
+                for (int b = 0; b < 3; ++b) x[b] = box.lo[b] + u(rng) * (box.hi[b] - box.lo[b]);
+                x[a] = box.lo[a] + c * g.width[a] + t * l.step[a];
+                const sphere::lattice_point q = sphere::reference_in_cell(g, l, x), nearest = l.encode(x);
+                const vec3<double> p = l.decode(q);
+                ++tried;
+                moved += q.x != nearest.x || q.y != nearest.y || q.z != nearest.z;
+                other_cell += g.cell_of(p) != g.cell_of(x);
+                for (int b = 0; b < 3; ++b) far += std::fabs(p[b] - x[b]) > l.step[b];
+            }
+    INFO(tried << " positions, " << moved << " a step back from the nearest point");
+    CHECK(moved > 0); // the case is exercised: the nearest point of some lies across the face
+    CHECK(other_cell == 0);
+    CHECK(far == 0);
+}
+
+TEMPLATE_TEST_CASE("the particle check counts the reference positions' rounding as displacement", "[grid]", double,
+                   sphere::mixed)
+{
+    using P = TestType;
+    using Real = sphere_test::user_real<P>;
+    sphere::settings<Real> s = sphere_test::box_settings<Real>();
+    s.gravity = {0, 0, 0};
+    const sphere::position_lattice<double> l = sphere::position_lattice<double>::over(s.box);
+    // A skin of the rounding e: the particles rest, a displacement d from their reference
+    // positions below e / 2, but from the positions of the rebuild up to d + e, more than e / 2:
+    // the check cannot rule out a pair that came closer than the skin, and rebuilds every step.
+    s.skin = Real(l.rounding());
+    std::vector<sphere::particle<Real>> ps;
+    for (int i = 0; i < 4; ++i)
+        for (int j = 0; j < 4; ++j)
+            ps.push_back(sphere_test::ball<Real>({Real(-0.05 + 0.031 * i + 1e-4 * j), Real(-0.05 + 0.029 * j), Real(0.01 * i)}));
+    sphere::simulation<P> sim(s, ps);
+    const sphere::simulation_state<Real> st = sim.state();
+    double d = 0;
+    for (std::size_t i = 0; i < ps.size(); ++i)
+        d = std::max(d, norm(sphere_test::to_double(st.particles.position(i)) - st.x_at_build[i].xyz()));
+    REQUIRE(2 * d < double(s.skin));
+    for (int k = 0; k < 3; ++k) sim.step();
+    const sphere::particle_snapshot<Real> snap = sim.snapshot();
+    for (std::size_t i = 0; i < ps.size(); ++i) REQUIRE(snap.position(i) == ps[i].position); // at rest
+    CHECK(sim.rebuilds() == 3); // the constructor's, then every step's check asks the next step for one
 }
 
 } // namespace test_grid

@@ -366,6 +366,7 @@ public:
         const std::size_t n = particles.size();
         std::vector<particle<Coord>>().swap(particles); // copied: its memory is not held through the first build
         walls_ = wall_set<Coord>::from_world(s.box);
+        lattice_ = position_lattice<Coord>::over(s.box);
         grid_ = neighbor_grid<Coord, Policy>(grid_geometry<Coord>::make(s.box, 2 * max_radius + s.skin + range_, s.cell_size));
         lists_ = contact_lists<Precision, Policy>(n, s.contact_forces, law_history_shape<Law>::value);
         summation_ = interaction<Precision, Policy>::resolve(s.pair_summation);
@@ -634,11 +635,11 @@ public:
         contacts.force.clear();
         simulation_state<Coord> st;
         st.particles = particles_.snapshot();
-        // the positions at the last rebuild with the radii (which they were built with)
-        const std::vector<vec3<Coord>> slots = x_at_build_.to_host();
+        // the reference positions of the last rebuild with the radii (which it was built with)
+        const std::vector<reference_position> slots = x_at_build_.to_host();
         std::vector<vec4<Coord>> x_at_build(slots.size());
         for (std::size_t k = 0; k < slots.size(); ++k) {
-            const vec3<Coord>& a = slots[k];
+            const vec3<Coord> a = lattice_.decode(slots[k]);
             x_at_build[user[k]] = {a.x, a.y, a.z, st.particles.x[user[k]].w};
         }
         st.contacts = std::move(contacts);
@@ -702,9 +703,18 @@ public:
         // order the state was saved in.
         std::vector<unsigned> identity(size());
         for (std::size_t i = 0; i < size(); ++i) identity[i] = static_cast<unsigned>(i);
+        // the state's build positions as reference positions (a state() gives them already,
+        // which stay where they are)
+        std::vector<reference_position> reference(size());
+        std::vector<vec4<Coord>> on_lattice(size());
+        for (std::size_t i = 0; i < size(); ++i) {
+            reference[i] = reference_in_cell(grid_.geometry(), lattice_, s.x_at_build[i].xyz());
+            const vec3<Coord> a = lattice_.decode(reference[i]);
+            on_lattice[i] = {a.x, a.y, a.z, s.x_at_build[i].w};
+        }
         buffer<vec4<Coord>, Policy> x_build;
         buffer<unsigned, Policy> users;
-        x_build.assign(s.x_at_build);
+        x_build.assign(on_lattice);
         users.assign(identity);
         particle_view<Precision> at_build{};
         at_build.n = size();
@@ -728,7 +738,7 @@ public:
         particles_.restore(restored);
         largest_radius_ = 0;
         for (const vec4<Coord>& x : restored.x) largest_radius_ = x.w > largest_radius_ ? x.w : largest_radius_;
-        lists_.restore(s.contacts, g, near_skin() + range_, !settings_.reorder);
+        lists_.restore(s.contacts, g, near_reach(), !settings_.reorder);
         far_clear_ = false; // the table's other partners may have histories
         moved_ = std::numeric_limits<double>::infinity(); // until the next particle check
         interaction_.lists_changed();
@@ -738,8 +748,8 @@ public:
         fresh.lists.near_entries = unsigned(lists_.near_entries());
         fresh.lists.wall_particles = unsigned(wall_launch_);
         report_.assign(std::vector<detail::step_report<Coord>>{fresh});
-        std::vector<vec3<Coord>> slots(size());
-        for (std::size_t k = 0; k < size(); ++k) slots[k] = s.x_at_build[storage[k]].xyz();
+        std::vector<reference_position> slots(size());
+        for (std::size_t k = 0; k < size(); ++k) slots[k] = reference[storage[k]];
         x_at_build_.assign(slots);
         if (external_.size()) { // external forces follow their particles into the new slots
             const std::vector<vec3<Real>> old = external_.to_host();
@@ -838,21 +848,24 @@ private:
     /// settle_rebuild() takes them once read back.
     void rebuild_lists(list_totals* totals)
     {
-        // The lists are built from the positions of this rebuild in rank order: with
-        // settings.reorder the particles' own, once permuted into that order (by way of
-        // x_at_build_, which then holds them as the positions at the rebuild of each slot);
-        // without it a copy that the grid gathers.
+        // The positions of this rebuild place the particles in the grid and decide which
+        // partners are listed; their reference positions (x_at_build_, each in its particle's
+        // cell: boundary/position_lattice.cuh, reference_in_cell) decide the near partners
+        // (docs/architecture.md, *Reference positions*). With settings.reorder both are read in
+        // place once they are permuted into rank order, without it the grid gathers them.
         const particle_view<Precision> p = particles_.view();
+        for_each_index(Policy{}, p.n,
+                       detail::place_references<Coord>{grid_.geometry(), lattice_, p.x, x_at_build_.data()});
+        const position_source<Coord> at_build{p.x, x_at_build_.data(), lattice_};
         if (settings_.reorder) {
-            grid_.order(context_, p);
-            particles_.permute(grid_.view().order, x_at_build_.data(), external_);
-            grid_.sorted(p.x);
+            grid_.order(context_, p.n, at_build, p.user);
+            particles_.permute(grid_.view().order, external_, x_at_build_);
+            grid_.sorted(at_build);
             bonds_.locate(p);
         } else {
-            grid_.build(context_, p);
-            for_each_index(Policy{}, p.n, detail::position_part<Coord>{p.x, x_at_build_.data()});
+            grid_.build(context_, p.n, at_build, p.user);
         }
-        lists_.rebuild(context_, grid_.view(), walls_, settings_.skin + range_, near_skin() + range_, !settings_.reorder,
+        lists_.rebuild(context_, grid_.view(), walls_, settings_.skin + range_, near_reach(), !settings_.reorder,
                        totals);
         interaction_.lists_changed();
         wall_launch_ = size(); // the wall particles are known once the totals are read back
@@ -864,7 +877,7 @@ private:
     bool settle_rebuild(const list_totals& t, bool headroom = true)
     {
         if (!lists_.settle(t, headroom)) {
-            if (settings_.reorder) particles_.unpermute(grid_.view().order, x_at_build_.data(), external_);
+            if (settings_.reorder) particles_.unpermute(grid_.view().order, external_, x_at_build_);
             return false;
         }
         wall_launch_ = t.wall_particles;
@@ -1094,20 +1107,23 @@ private:
 
     detail::check_particle<Precision> check()
     {
-        return {particles_.view(), x_at_build_.data(), settings_.box, walls_};
+        return {particles_.view(), x_at_build_.data(), lattice_, settings_.box, walls_};
     }
 
-    /// Acts on the particle check of step `step` (the largest squared displacement): a
-    /// sphere::error naming the step and the particle (the lowest user index) when one failed
-    /// it; marks the lists for a rebuild when a particle and a wall may have come closer than
-    /// the skin, with each displacement taken `margin` (m) longer.
+    /// Acts on the particle check of step `step` (the largest squared displacement from the
+    /// reference positions): a sphere::error naming the step and the particle (the lowest user
+    /// index) when one failed it; marks the lists for a rebuild when a particle and a wall may
+    /// have come closer than the skin, with each displacement taken `margin` (m) longer, and
+    /// longer by the reference positions' rounding (the lists were built from the positions
+    /// they round: docs/architecture.md, *Reference positions*).
     void judge(Coord moved2, std::size_t step, double margin = 0)
     {
         if (!std::isfinite(moved2))
             report_bad_particle(transform_reduce(Policy{}, size(), detail::bad_particle<Precision>{check()},
                                                  ~std::size_t(0), min_op{}),
                                 step);
-        const double moved = std::sqrt(double(moved2)) + margin, skin = double(settings_.skin);
+        const double moved = std::sqrt(double(moved2)) + margin + double(lattice_.rounding()),
+                     skin = double(settings_.skin);
         moved_ = moved;
         bool rebuild = 2 * moved > skin;
         for (int f = 0; f < wall_set<Coord>::count; ++f)
@@ -1130,6 +1146,12 @@ private:
     /// (+ the law's range) at the rebuild, an eighth of the skin (docs/architecture.md, *Near
     /// partners*).
     Coord near_skin() const { return settings_.skin / 8; }
+
+    /// What the lists' near rows add to r_a + r_b between reference positions (m): the near
+    /// skin, the law's range and twice the reference positions' rounding, so that a pair
+    /// within r_a + r_b + near skin + range of the positions of the rebuild is a near pair
+    /// (docs/architecture.md, *Reference positions*).
+    Coord near_reach() const { return near_skin() + range_ + 2 * lattice_.rounding(); }
 
     /// Whether the other partners of the lists are still apart: no particle has moved a half
     /// near skin since the rebuild (moved_, from the last particle check), less a margin for the
@@ -1380,7 +1402,10 @@ private:
     contact_lists<Precision, Policy> lists_;
     interaction<Precision, Policy> interaction_;
     pair_summation summation_ = pair_summation::slabs; ///< settings_.pair_summation, resolved for the backend
-    buffer<vec3<Coord>, Policy> x_at_build_; ///< positions at the last rebuild of each slot
+    using reference_position = typename position_lattice<Coord>::stored;
+    position_lattice<Coord> lattice_; ///< of the reference positions, over settings_.box
+    /// the reference position of each slot at the last rebuild (boundary/position_lattice.cuh)
+    buffer<reference_position, Policy> x_at_build_;
     execution_context<Policy> context_;
     buffer<detail::step_report<Coord>, Policy> report_; ///< one, written by the step's reductions
     wall_set<Coord> walls_at_build_;      ///< the walls when the lists were built

@@ -148,7 +148,8 @@ SPHERE_HDI bool within_skin(const world<Real>& box, const vec4<Real>& xi, const 
 /// Scans the cells around the particle at rank k and visits the partners it owns within reach
 /// (`pair(q, near)` with the partner's rank q, and whether it lies within the near skin) and
 /// then every active wall within r + skin (`wall(f)`). Owned partners lie in k's own layer at
-/// a higher rank or in the next layer, so only those two layers are scanned.
+/// a higher rank or in the next layer, so only those two layers are scanned. Where the grid
+/// has reference positions (each in its particle's cell), they decide the near partners.
 template <class Real>
 struct neighbour_scan {
     grid_view<Real> grid;
@@ -159,10 +160,19 @@ struct neighbour_scan {
     template <class Visit>
     SPHERE_HD void operator()(std::size_t k, Visit& visit) const
     {
+        // the kind of near test decided once, not for every candidate
+        if (grid.sorted_x.reference) scan<true>(k, visit);
+        else scan<false>(k, visit);
+    }
+
+private:
+    template <bool Reference, class Visit>
+    SPHERE_HD void scan(std::size_t k, Visit& visit) const
+    {
         // Cell coordinates along the slow, mid and fast axes, in scalars (arrays indexed by
         // run-time axes would live in local memory on CUDA).
         const grid_geometry<Real>& g = grid.geometry;
-        const vec4<Real> xi = grid.sorted_x[k];
+        const vec4<Real> xi = grid.sorted_x.x[k];
         const int cs = g.coordinate(component(xi.xyz(), g.slow), g.slow);
         const int cm = g.coordinate(component(xi.xyz(), g.mid), g.mid);
         const int cf = g.coordinate(component(xi.xyz(), g.fast), g.fast);
@@ -190,8 +200,10 @@ struct neighbour_scan {
                     f1 = f1 >= nf ? nf - 1 : f1;
                 }
                 const std::size_t above = ds == 0 ? k + 1 : 0; // same layer: higher ranks only
-                scan_run(xi, g.index_in_order(s, m, f0), g.index_in_order(s, m, f1), above, visit);
-                if (wrapped1 >= 0) scan_run(xi, g.index_in_order(s, m, wrapped0), g.index_in_order(s, m, wrapped1), above, visit);
+                scan_run<Reference>(k, xi, g.index_in_order(s, m, f0), g.index_in_order(s, m, f1), above, visit);
+                if (wrapped1 >= 0)
+                    scan_run<Reference>(k, xi, g.index_in_order(s, m, wrapped0), g.index_in_order(s, m, wrapped1),
+                                        above, visit);
             }
         }
         SPHERE_UNROLL
@@ -204,7 +216,6 @@ struct neighbour_scan {
         }
     }
 
-private:
     /// Wraps cell coordinate c on a periodic axis; false when it lies outside a wall axis.
     SPHERE_HD bool wrap_or_reject(int& c, int a) const
     {
@@ -216,17 +227,27 @@ private:
         return c >= 0 && c < n;
     }
 
-    template <class Visit>
-    SPHERE_HD void scan_run(const vec4<Real>& xi, unsigned first_cell, unsigned last_cell, std::size_t above,
-                            Visit& visit) const
+    /// The candidates in cells [first_cell, last_cell] (from rank `above` on) of rank k at xi.
+    template <bool Reference, class Visit>
+    SPHERE_HD void scan_run(std::size_t k, const vec4<Real>& xi, unsigned first_cell, unsigned last_cell,
+                            std::size_t above, Visit& visit) const
     {
         const unsigned end = grid.cell_start[last_cell + 1];
         unsigned q = grid.cell_start[first_cell];
         if (q < above) q = static_cast<unsigned>(above < end ? above : end);
+        const position_source<Real>& at = grid.sorted_x;
+        const world<Real>& box = grid.geometry.box;
         for (; q < end; ++q) {
-            const vec4<Real> xq = grid.sorted_x[q];
-            if (within_skin(grid.geometry.box, xi, xq, skin))
-                visit.pair(q, within_skin(grid.geometry.box, xi, xq, near_skin));
+            const vec4<Real> xq = at.x[q];
+            if (!within_skin(box, xi, xq, skin)) continue;
+            if constexpr (Reference) {
+                // the separation of the reference positions (as within_skin forms it between them)
+                const Real reach = xi.w + xq.w + near_skin;
+                visit.pair(q, norm2(box.nearest_image(at.lattice.between(at.reference[k], at.reference[q]))) <
+                                  reach * reach);
+            } else {
+                visit.pair(q, within_skin(box, xi, xq, near_skin));
+            }
         }
     }
 };
@@ -746,7 +767,8 @@ public:
             detail::fail("contact lists: the restored table's histories have ", t.shape.lanes,
                          " lanes beside the base, the contact law's have ", shape.lanes);
         const std::vector<unsigned> user_of_rank = buffer_copy(grid.order, n);
-        const std::vector<vec4<Coord>> x = buffer_copy(grid.sorted_x, n);
+        // the positions of the last rebuild (a grid over them without reference positions)
+        const std::vector<vec4<Coord>> x = buffer_copy(grid.sorted_x.x, n);
         std::vector<unsigned> rank_of_user(n);
         for (std::size_t r = 0; r < n; ++r) rank_of_user[user_of_rank[r]] = static_cast<unsigned>(r);
         const grid_geometry<Coord>& g = grid.geometry;

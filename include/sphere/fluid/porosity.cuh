@@ -195,7 +195,7 @@ private:
     {
         const unsigned end = bins.cell_start[last_bin + 1];
         for (unsigned k = bins.cell_start[first_bin]; k < end; ++k) {
-            const vec4<Real> xj = bins.sorted_x[k];
+            const vec4<Real> xj = bins.sorted_x.x[k];
             const vec3<Real> d = fluid.box.nearest_image(xj.xyz() - cell.centre);
             const Real V = method == porosity_method::cell_sphere ? lens_volume(radius, xj.w, std::sqrt(norm2(d)))
                                                                   : volume_in_cell(d, xj.w, cell);

@@ -35,7 +35,7 @@ struct grid_geometry {
     SPHERE_HD unsigned layers() const { return cells(slow); }
 
     /// Cell coordinate of c along axis a, clamped into the grid.
-    SPHERE_HD int coordinate(Real c, int a) const
+    SPHERE_HDI int coordinate(Real c, int a) const
     {
         const unsigned na = cells(a);
         const Real f = std::floor((c - component(box.lo, a)) / component(width, a));

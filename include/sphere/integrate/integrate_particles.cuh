@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "../boundary/position_lattice.cuh"
 #include "../boundary/walls.cuh"
 #include "../boundary/world.cuh"
 #include "../core/constants.cuh"
@@ -189,7 +190,8 @@ template <class P>
 struct check_particle {
     using Coord = coord_t<P>;
     particle_view<P> p;
-    const vec3<Coord>* x_at_build;
+    const typename position_lattice<Coord>::stored* x_at_build; ///< reference positions at the last rebuild
+    position_lattice<Coord> lattice;
     world<Coord> box;
     wall_set<Coord> walls;
 
@@ -215,7 +217,7 @@ struct check_particle {
         // cannot load fields conditionally in SIMD lanes): a NaN becomes +infinity, and a bad
         // particle's +infinity wins the maximum.
         const Coord inf = infinity<Coord>;
-        Coord moved = norm2(box.nearest_image_inside(pos - x_at_build[i])); // both wrapped
+        Coord moved = norm2(box.nearest_image_inside(pos - lattice.decode(x_at_build[i]))); // both wrapped
         moved = moved == moved ? moved : inf;
         const Coord flag = bad_at(i, pos) ? inf : Coord(0);
         return moved > flag ? moved : flag;

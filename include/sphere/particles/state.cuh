@@ -71,37 +71,36 @@ struct scatter {
     SPHERE_HD void operator()(std::size_t k) const { to[order[k]] = from[k]; }
 };
 
-/// The position and radius of slot order[k] into xyz[k] and radius[k] (Gather, like gather),
-/// or those of slot k into xyz[order[k]] and radius[order[k]] (like scatter).
-template <class Coord, bool Gather>
-struct split_position {
-    const vec4<Coord>* x;
+/// Coordinate C (0 .. 2: x, y, z; 3: the radius) of a position and radius.
+template <int C, class Coord>
+SPHERE_HDI Coord& coordinate(vec4<Coord>& v)
+{
+    if constexpr (C == 0) return v.x;
+    else if constexpr (C == 1) return v.y;
+    else if constexpr (C == 2) return v.z;
+    else return v.w;
+}
+
+/// Coordinate C of the position of slot order[k] into to[k] (Gather, like gather), or that of
+/// slot k into to[order[k]] (like scatter).
+template <int C, class Coord, bool Gather>
+struct move_coordinate {
+    vec4<Coord>* x;
     const unsigned* order;
-    vec3<Coord>* xyz;
-    Coord* radius;
+    Coord* to;
     SPHERE_HD void operator()(std::size_t k) const
     {
-        const std::size_t from = Gather ? order[k] : k, to = Gather ? k : order[k];
-        xyz[to] = x[from].xyz();
-        radius[to] = x[from].w;
+        if constexpr (Gather) to[k] = coordinate<C>(x[order[k]]);
+        else to[order[k]] = coordinate<C>(x[k]);
     }
 };
 
-/// xyz[k] = the position of x[k] (its radius left out).
-template <class Coord>
-struct position_part {
-    const vec4<Coord>* x;
-    vec3<Coord>* xyz;
-    SPHERE_HD void operator()(std::size_t k) const { xyz[k] = x[k].xyz(); }
-};
-
-/// x[k] = (xyz[k], radius[k]).
-template <class Coord>
-struct join_position {
-    const vec3<Coord>* xyz;
-    const Coord* radius;
+/// Coordinate C of x[k] = from[k].
+template <int C, class Coord>
+struct set_coordinate {
+    const Coord* from;
     vec4<Coord>* x;
-    SPHERE_HD void operator()(std::size_t k) const { x[k] = {xyz[k].x, xyz[k].y, xyz[k].z, radius[k]}; }
+    SPHERE_HD void operator()(std::size_t k) const { coordinate<C>(x[k]) = from[k]; }
 };
 
 /// to[k] = from[k] (kernel body of a copy).
@@ -228,24 +227,22 @@ public:
 
     /// Moves the particle in slot order[k] to slot k, for every k (order is a permutation),
     /// and with it every array in `along` that must stay in step with the particles (e.g.
-    /// external forces; an empty one stays empty). The positions go by way of `xyz` (n
-    /// elements of policy memory, which hold them in the new order afterwards) and the radii
-    /// by way of the forces' array. The forces are not carried (the next force evaluation
-    /// writes them): their array is the permutation's scratch and holds zeros afterwards.
+    /// external forces, the positions at the last rebuild; an empty one stays empty). The
+    /// forces are not carried (the next force evaluation writes them): their array is the
+    /// permutation's scratch and holds zeros afterwards.
     template <class... Along>
-    void permute(const unsigned* order, vec3<Coord>* xyz, Along&... along)
+    void permute(const unsigned* order, Along&... along)
     {
-        move_positions<detail::gather>(order, xyz);
+        move_positions<true>(order);
         move_fields<detail::gather>(order, along...);
     }
 
-    /// Undoes permute(order, xyz, along...): every particle and `along` array back into the
-    /// slot it had before (`xyz` then holds the positions in those slots; the forces, scratch,
-    /// are left zero). Every array keeps its address.
+    /// Undoes permute(order, along...): every particle and `along` array back into the slot it
+    /// had before (the forces, scratch, are left zero). Every array keeps its address.
     template <class... Along>
-    void unpermute(const unsigned* order, vec3<Coord>* xyz, Along&... along)
+    void unpermute(const unsigned* order, Along&... along)
     {
-        move_positions<detail::scatter>(order, xyz);
+        move_positions<false>(order);
         move_fields<detail::scatter>(order, along...);
     }
 
@@ -353,19 +350,29 @@ private:
         for_each_index(Policy{}, force_.size(), detail::fill_value<vec3<Real>>{force_.data(), {0, 0, 0}});
     }
 
-    /// Moves the positions through `order` by `Move` into `xyz` and the radii into the forces'
-    /// array, and joins them back in x_.
-    template <template <class> class Move>
-    void move_positions(const unsigned* order, vec3<Coord>* xyz)
+    /// Moves the positions and radii through `order` (Gather: like detail::gather, else like
+    /// detail::scatter) one coordinate at a time by way of the forces' array, which holds a
+    /// coordinate of every particle (no array as large as the positions' is needed).
+    template <bool Gather>
+    void move_positions(const unsigned* order)
     {
-        // A radius fits in a force's place, and buffers start at least 16-B aligned (operator
-        // new, cudaMalloc): a double is aligned in the forces' array of mixed precision too.
-        static_assert(sizeof(Coord) <= sizeof(vec3<Real>) && alignof(Coord) <= 16, "a radius fits in a force's place");
-        Coord* radius = reinterpret_cast<Coord*>(force_.data());
+        // A coordinate fits in a force's place, and buffers start at least 16-B aligned
+        // (operator new, cudaMalloc): a double is aligned in the forces' array of mixed
+        // precision too.
+        static_assert(sizeof(Coord) <= sizeof(vec3<Real>) && alignof(Coord) <= 16, "a coordinate fits in a force's place");
+        move_coordinate<0, Gather>(order);
+        move_coordinate<1, Gather>(order);
+        move_coordinate<2, Gather>(order);
+        move_coordinate<3, Gather>(order);
+    }
+
+    template <int C, bool Gather>
+    void move_coordinate(const unsigned* order)
+    {
+        Coord* tmp = reinterpret_cast<Coord*>(force_.data());
         const std::size_t n = x_.size();
-        constexpr bool gathers = std::is_same_v<Move<Coord>, detail::gather<Coord>>;
-        for_each_index(Policy{}, n, detail::split_position<Coord, gathers>{x_.data(), order, xyz, radius});
-        for_each_index(Policy{}, n, detail::join_position<Coord>{xyz, radius, x_.data()});
+        for_each_index(Policy{}, n, detail::move_coordinate<C, Coord, Gather>{x_.data(), order, tmp});
+        for_each_index(Policy{}, n, detail::set_coordinate<C, Coord>{tmp, x_.data()});
     }
 
     /// Moves one field through `order` by `Move` into the forces' array (for the accumulated
