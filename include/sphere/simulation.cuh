@@ -227,7 +227,9 @@ struct simulation_state {
     particle_snapshot<Real> particles;  ///< in user order
     contact_table<Real> contacts;        ///< the contact lists and their history (forces left out)
     bond_table<Real> bonds;              ///< the bonds and their state
-    std::vector<vec4<Real>> x_at_build; ///< positions (xyz) and radii (w) when the lists were built, in user order
+    /// the reference positions (xyz; docs/architecture.md, *Reference positions*) and the radii
+    /// (w) of the last rebuild, in user order
+    std::vector<vec4<Real>> x_at_build;
     std::vector<unsigned> storage;       ///< the user index of each storage slot (the storage order)
     wall_set<Real> walls;
     wall_set<Real> walls_at_build; ///< the walls when the lists were built
