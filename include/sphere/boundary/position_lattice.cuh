@@ -3,9 +3,9 @@
 /// How the simulation keeps each particle's position at the last rebuild of the contact lists
 /// (its reference position): in double, as a point of a fixed-point lattice over the world
 /// (three 32-bit steps, 12 B instead of 24); in float, as the position itself (12 B already).
-/// The grid and the lists are built from the reference positions themselves, not from the
-/// positions they round, so the rebuild check's argument holds for them exactly
-/// (docs/architecture.md, *Reference positions*).
+/// The grid and the lists place and list the particles by their own positions; the reference
+/// positions decide the near rows and measure the displacements since the rebuild, with
+/// margins of their rounding (docs/architecture.md, *Reference positions*).
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -25,9 +25,11 @@ struct lattice_point {
 /// The lattice of reference positions over a world of positions in Coord. In double its step
 /// along each axis is a power of two, at least the box's length / (2^32 - 2), and its origin a
 /// multiple of the step at most one step below the box: every point origin + q step is a
-/// double exactly, encoding it gives q back, and 2^32 - 1 steps cover the box. A position
-/// rounds to the nearest point (at most half a step, 2.3e-10 of the box's length, away along
-/// each axis), clamped into the lattice. Other types store positions as they are.
+/// double exactly, encoding it gives q back, and 2^32 - 1 steps cover the box. encode() rounds
+/// a position to the nearest point (at most half a step, 2.3e-10 of the box's length, away
+/// along each axis), clamped into the lattice; a particle's reference position is that point
+/// or its neighbour in the particle's grid cell (grid/neighbor_grid.cuh, reference_in_cell).
+/// Other types store positions as they are.
 template <class Coord>
 struct position_lattice {
     static constexpr bool fixed_point = std::is_same_v<Coord, double>;
@@ -38,8 +40,8 @@ struct position_lattice {
     vec3<Coord> per_step{1, 1, 1}; ///< 1 / step (1/m), exact (a power of two)
 
     /// The lattice over `box`; throws sphere::error for a box that it cannot cover exactly
-    /// (an axis of non-finite or no length, or one that lies more than 2^20 of its lengths
-    /// from the coordinates' origin).
+    /// (an axis of non-finite or no length, or one whose lower end lies more than 2^52 steps,
+    /// about 2^20 of its lengths, from the coordinates' origin).
     static position_lattice over(const world<Coord>& box)
     {
         position_lattice l;
