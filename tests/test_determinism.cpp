@@ -565,6 +565,63 @@ TEMPLATE_TEST_CASE("pair sums by slabs and by gather agree to round-off", "[dete
     }
 }
 
+TEMPLATE_TEST_CASE("owners away from the periodic faces skip the nearest image: every contact's force is the gather "
+                   "schedule's, bit for bit, also across the faces",
+                   "[determinism][summation]", float, double, sphere::mixed)
+{
+    using P = TestType;
+    using Real = sphere_test::user_real<P>;
+    // The slab schedule separates an owner that lies farther than (r_i + r_max + range) 17/16
+    // from the faces of the periodic axes by x_i - x_j alone (pair_contact::images_inside); the
+    // gather schedule always takes the nearest image. Each contact's recorded force (at
+    // construction: the same positions and velocities for both) depends on its separation's
+    // bits only, not on the order of any sum, so the two must agree to the bit. The compressed
+    // crystal's columns lie 1, 3, ..., 19 r0 from the faces of x and y, and the margin is about
+    // 2.3 r0: the outer columns' owners (36%) take the nearest image, the others do not, and
+    // the outer columns touch across the faces.
+    auto setup = compressed_crystal<Real>();
+    setup.first.contact_forces = true;
+    std::mt19937 gen(11);
+    std::normal_distribution<double> normal(0.0, 1.0);
+    for (sphere::particle<Real>& p : setup.second)
+        for (int a = 0; a < 3; ++a) {
+            p.velocity[a] = Real(0.01 * normal(gen));
+            p.angular_velocity[a] = Real(normal(gen));
+        }
+    auto contacts = [&](sphere::pair_summation how) {
+        sphere::settings<Real> s = setup.first;
+        s.pair_summation = how;
+        // velocity Verlet evaluates the forces of the start at construction
+        return sphere::simulation<P, sphere_test::policy, sphere::contact::linear<>, sphere::integrate::velocity_verlet>(
+                   s, setup.second)
+            .contacts();
+    };
+    const auto a = contacts(sphere::pair_summation::slabs), b = contacts(sphere::pair_summation::gather);
+
+    const double r0 = 0.01, side = 20 * r0, margin = 2.2 * r0 * 17 / 16;
+    std::size_t near_face = 0, across = 0, acting = 0;
+    for (std::size_t i = 0; i < setup.second.size(); ++i) {
+        const auto& xi = setup.second[i].position;
+        bool near = false;
+        for (int ax = 0; ax < 2; ++ax) near = near || double(xi[ax]) + side / 2 < margin || side / 2 - double(xi[ax]) < margin;
+        near_face += near;
+        for (std::size_t e = b.begin(i); e < b.end(i); ++e) { // the reference's pairs
+            if (b.partner[e] >= sphere::wall_partner_base) continue;
+            const auto& xj = setup.second[b.partner[e]].position;
+            const bool touches = b.force[e].w != Real(0);
+            acting += touches;
+            for (int ax = 0; ax < 2; ++ax) across += touches && std::abs(double(xi[ax] - xj[ax])) > side / 2;
+        }
+    }
+    INFO(near_face << " of " << setup.second.size() << " particles within the margin of a periodic face; " << acting
+                   << " touching pairs, " << across << " of them across a face");
+    REQUIRE(near_face == 360);
+    REQUIRE(acting > 2000);
+    REQUIRE(across > 100);
+    CHECK(same_bytes(a.partner, b.partner));
+    CHECK(same_bytes(a.force, b.force));
+}
+
 TEMPLATE_TEST_CASE("run-time errors name the user's particle index, not its storage slot", "[determinism][reorder]",
                    float, double, sphere::mixed)
 {

@@ -1085,7 +1085,7 @@ private:
 
     detail::pair_contact<Precision, Law, Integrator::drifts_before_forces> pair_contact()
     {
-        return {particles_.view(), settings_.box, pair_params_, Real(dt_)};
+        return {particles_.view(), settings_.box, pair_params_, Real(dt_), largest_radius_ + range_};
     }
 
     /// The wall contacts of the particles that have some (one index per wall particle, in rank

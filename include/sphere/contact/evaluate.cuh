@@ -94,11 +94,14 @@ SPHERE_HDI bool law_acts(const KernelParams& params, Coord dist2, Coord reach)
 /// The separation s of particles at xi and xj (centre in xyz, radius in w; type Coord) in the
 /// world box, the nearest image, and whether Law with kernel parameters `params` acts on them
 /// (law_acts). s is filled either way, so that callers can sort pairs without a branch.
-template <class Law, class Real, class KernelParams, class Coord>
+/// Without `Image`, x_i - x_j itself: for an owner whose acting partners cannot lie across a
+/// periodic face (pair_contact::images_inside), the same verdict, and for a pair that acts
+/// the same bits.
+template <class Law, bool Image = true, class Real, class KernelParams, class Coord>
 SPHERE_HDI bool separate(const KernelParams& params, const world<Coord>& box, const vec4<Coord>& xi,
                          const vec4<Coord>& xj, pair_separation<Real>& s)
 {
-    const vec3<Coord> d = box.nearest_image_inside(xi.xyz() - xj.xyz());
+    const vec3<Coord> d = Image ? box.nearest_image_inside(xi.xyz() - xj.xyz()) : xi.xyz() - xj.xyz();
     const Coord dist2 = norm2(d);
     s = separation_of<Real>(d, dist2, xi.w, xj.w);
     return law_acts<Law>(params, dist2, xi.w + xj.w);
@@ -161,8 +164,27 @@ struct pair_contact {
     world<Coord> box;
     typename Law::template kernel_params<Real> params;
     Real dt;
+    /// the largest radius plus the law's range (m): no pair acts whose centres lie farther apart
+    /// than r_i + partner_reach
+    Coord partner_reach;
     using history_type = law_history_t<Law, Real>;
     static constexpr bool materials = law_material_count<Law>::value > 1;
+
+    /// Whether particle i at xi (centre in xyz, radius in w) has no partner the law can act on
+    /// across a periodic face of the box: on each periodic axis it lies farther than
+    /// r_i + partner_reach (and a sixteenth more, for rounding) from both faces. Then an acting
+    /// partner's nearest image lies inside the box, where its (wrapped) position is, so that
+    /// x_i - x_j is its separation to the bit, and every other pair, whose images are all
+    /// farther than the nearest, stays apart: separate<Law, false> gives the same verdicts
+    /// without the nearest image (docs/architecture.md, *Interaction*).
+    SPHERE_HDI bool images_inside(const vec4<Coord>& xi) const
+    {
+        const Coord margin = (xi.w + partner_reach) * Coord(17) / Coord(16);
+        bool inside = true;
+        for (int a = 0; a < 3; ++a)
+            inside = inside && (!box.periodic(a) || (xi.xyz()[a] - box.lo[a] > margin && box.hi[a] - xi.xyz()[a] > margin));
+        return inside;
+    }
 
     /// The separation s of particles at xi and xj (p.x) and whether the law acts on them:
     /// distinct centres that overlap, or for a law that acts apart (contact/law.cuh) lie

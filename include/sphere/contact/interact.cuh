@@ -7,6 +7,7 @@
 /// thread count and storage order. Walls are evaluated afterwards, per particle, with the
 /// integration (simulation.cuh).
 #include <cstddef>
+#include <type_traits>
 #include <vector>
 
 #ifdef _OPENMP
@@ -95,7 +96,8 @@ struct slab_pairs {
         for (unsigned r = first_rank; r < end_rank; ++r) {
             const unsigned i = static_cast<unsigned>(c.slot(r));
             const vec4<Coord> xi = x[i];
-            const auto pair = [&](unsigned e, unsigned j) {
+            // `image`: whether the row's separations need the nearest image (images_inside)
+            const auto pair = [&](unsigned e, unsigned j, auto image) {
                 t.owner[t.count] = i;
                 t.partner[t.count] = j;
                 t.entry[t.count] = e;
@@ -103,7 +105,7 @@ struct slab_pairs {
                 // displacements, but cannot gather bytes
                 t.hw[t.count] = Real(flags[e]);
                 pair_separation<Real> s;
-                const bool touching = sphere::detail::separate<Law>(params, box, xi, x[j], s);
+                const bool touching = sphere::detail::separate<Law, decltype(image)::value>(params, box, xi, x[j], s);
                 t.dx[t.count] = s.d.x;
                 t.dy[t.count] = s.d.y;
                 t.dz[t.count] = s.d.z;
@@ -118,13 +120,18 @@ struct slab_pairs {
                 if (apart_count == tile::width) forget(apart, apart_count);
                 if (t.count == tile::width) flush(t);
             };
-            for (unsigned e = c.offset[r], end = c.offset[r + 1]; e < end; ++e) {
-                const unsigned j = partner[e];
-                if (j >= wall_partner_base) break; // walls come last in a near row
-                pair(e, j);
-            }
-            if (!near_only)
-                for (unsigned e = c.far_begin(r), end = c.far_end(r); e < end; ++e) pair(e, partner[e]);
+            const auto walk = [&](auto image) {
+                for (unsigned e = c.offset[r], end = c.offset[r + 1]; e < end; ++e) {
+                    const unsigned j = partner[e];
+                    if (j >= wall_partner_base) break; // walls come last in a near row
+                    pair(e, j, image);
+                }
+                if (!near_only)
+                    for (unsigned e = c.far_begin(r), end = c.far_end(r); e < end; ++e) pair(e, partner[e], image);
+            };
+            // most owners lie away from the periodic faces: their walk skips the nearest image
+            if (eval.images_inside(xi)) walk(std::false_type{});
+            else walk(std::true_type{});
         }
         if (t.count) flush(t);
         forget(apart, apart_count);
