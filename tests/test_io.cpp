@@ -263,7 +263,8 @@ TEMPLATE_TEST_CASE("checkpoints convert between float and double", "[io][checkpo
     host_sim<Other> converted = sphere::restart<host_sim<Other>>(path);
     converted.run(100);
     original.run(100);
-    const auto a = original.snapshot(), b = converted.snapshot();
+    const auto a = original.snapshot();
+    const auto b = converted.snapshot();
     double worst = 0;
     for (std::size_t i = 0; i < a.size(); ++i)
         for (int k = 0; k < 3; ++k) worst = std::max(worst, std::abs(double(a.position(i)[k]) - double(b.position(i)[k])));

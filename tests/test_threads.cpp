@@ -116,8 +116,8 @@ TEST_CASE("host_team_limit caps the threads of the host loops", "[threads]")
 {
     thread_state_guard guard;
     omp_set_num_threads(2);
-    const std::size_t n = 64 * sphere::host_chunk;
-    auto most_seen = [n] {
+    constexpr std::size_t n = 64 * sphere::host_chunk;
+    auto most_seen = [] {
         std::vector<int> seen(n);
         int* out = seen.data();
         sphere::for_each_index(sphere::host{}, n, [out](std::size_t i) { out[i] = omp_get_num_threads(); });

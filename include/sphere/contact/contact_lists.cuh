@@ -700,9 +700,10 @@ public:
         std::vector<vec4<Real>> frc;
         if (record_forces_) frc = force_.to_host();
         const std::vector<unsigned> slots = keep_order_ ? slot_of_rank_.to_host() : std::vector<unsigned>{};
-        // every entry twice (pairs) or once (walls), as (particle, partner, entry, mirrored)
+        // every entry twice (pairs) or once (walls), as (owner, partner, entry, mirrored)
         struct item {
-            unsigned particle, partner, entry;
+            unsigned owner, partner, entry; // not `particle`: clang 14 reads `a.particle <` as the
+                                            // template particle<...>
             bool mirrored;
         };
         std::vector<item> items;
@@ -721,11 +722,11 @@ public:
             for (unsigned e = off[n + r]; e < off[n + r + 1]; ++e) add(e);
         }
         std::sort(items.begin(), items.end(), [](const item& a, const item& b) {
-            return a.particle != b.particle ? a.particle < b.particle : a.partner < b.partner;
+            return a.owner != b.owner ? a.owner < b.owner : a.partner < b.partner;
         });
         contact_table<Coord> t;
         t.offset.assign(n + 1, 0);
-        for (const item& it : items) ++t.offset[it.particle + 1];
+        for (const item& it : items) ++t.offset[it.owner + 1];
         for (std::size_t i = 0; i < n; ++i) t.offset[i + 1] += t.offset[i];
         t.partner.reserve(items.size());
         t.history.reserve(items.size());

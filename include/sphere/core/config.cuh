@@ -27,9 +27,12 @@
 
 /// SPHERE_VECTORISE_LOOP before a loop whose iterations are independent: vectorise it. g++ is
 /// told `ivdep` (its `omp simd` privatises a loop's local structs into arrays, which it then
-/// cannot vectorise); other compilers `omp simd`.
+/// cannot vectorise), clang `vectorize(assume_safety)` (which it also takes as an order, and
+/// warns where it cannot: the CMake target turns that warning off), other compilers `omp simd`.
 #if defined(__GNUC__) && !defined(__clang__)
 #define SPHERE_VECTORISE_LOOP _Pragma("GCC ivdep")
+#elif defined(__clang__) && !defined(__CUDACC__)
+#define SPHERE_VECTORISE_LOOP _Pragma("clang loop vectorize(assume_safety)")
 #else
 #define SPHERE_VECTORISE_LOOP _Pragma("omp simd")
 #endif

@@ -81,7 +81,8 @@ template <class Real> SPHERE_HDI vec4<Real> select(bool c, const vec4<Real>& a, 
 template <class Real> SPHERE_HDI bool isfinite(const vec3<Real>& a)
 {
     const Real big = largest<Real>;
-    return (std::fabs(a.x) <= big) & (std::fabs(a.y) <= big) & (std::fabs(a.z) <= big);
+    const bool x = std::fabs(a.x) <= big, y = std::fabs(a.y) <= big, z = std::fabs(a.z) <= big;
+    return x & y & z;
 }
 
 /// Converts between precisions (e.g. a double vector from user input to the simulation's Real).

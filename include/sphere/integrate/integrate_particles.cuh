@@ -200,10 +200,14 @@ struct check_particle {
     /// bad(i), were particle i at `pos`.
     SPHERE_HDI bool bad_at(std::size_t i, const vec3<Coord>& pos) const
     {
-        bool out = !(isfinite(pos) & isfinite(p.v_sync[i]) & isfinite(p.omega_sync[i]));
+        const bool position_finite = isfinite(pos), velocity_finite = isfinite(p.v_sync[i]),
+                   spin_finite = isfinite(p.omega_sync[i]);
+        bool out = !(position_finite & velocity_finite & spin_finite);
         for (int a = 0; a < 3; ++a) {
-            const bool inside = (pos[a] >= Coord(walls.face[2 * a].position)) & (pos[a] <= Coord(walls.face[2 * a + 1].position));
-            out = out | (!box.periodic(a) & !inside);
+            const Coord c = pos[a];
+            const bool above = c >= Coord(walls.face[2 * a].position), below = c <= Coord(walls.face[2 * a + 1].position);
+            const bool walled = !box.periodic(a);
+            out = out | (walled & !(above & below));
         }
         return out;
     }
