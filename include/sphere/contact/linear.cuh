@@ -167,6 +167,24 @@ struct linear {
     }
 
 private:
+    /// What turns gamma into a dashpot coefficient, c = gamma scale: m_eff when mass-scaled,
+    /// 2 sqrt(m_eff k_n) as a ratio to critical damping, else 1.
+    template <class Real>
+    SPHERE_HDI static Real dashpot_scale(damping_convention convention, Real m_eff, Real k_n)
+    {
+        if constexpr (SPHERE_DEVICE_CODE) {
+            // a warp shares the convention: branches, and the square root only where it is used
+            if (convention == damping_convention::mass_scaled) return m_eff;
+            if (convention == damping_convention::damping_ratio) return Real(2) * std::sqrt(m_eff * k_n);
+            return Real(1);
+        } else {
+            // selects: clang vectorises no loop over pairs whose body branches on the convention
+            const Real ratio = Real(2) * std::sqrt(m_eff * k_n);
+            const Real scale = convention == damping_convention::damping_ratio ? ratio : Real(1);
+            return convention == damping_convention::mass_scaled ? m_eff : scale;
+        }
+    }
+
     template <class Tangential, class Real>
     SPHERE_HDI static contact_result<Real> evaluate(const contact_params<Real>& given, const contact_motion<Real>& m,
                                                    vec4<Real>& h, Real dt)
@@ -174,11 +192,7 @@ private:
         contact_params<Real> p = given;
         // gamma in 1/s when mass-scaled: c = gamma m_eff; a ratio to critical damping:
         // c = 2 gamma sqrt(m_eff k_n) (N s/m; docs/physics.md, "Normal force")
-        Real scale = Real(1);
-        if (p.damping == damping_convention::mass_scaled)
-            scale = m.m_eff;
-        else if (p.damping == damping_convention::damping_ratio)
-            scale = Real(2) * std::sqrt(m.m_eff * p.k_n);
+        const Real scale = dashpot_scale(p.damping, m.m_eff, p.k_n);
         p.gamma_n *= scale;
         p.gamma_t *= scale;
         const vec3<Real>& n = m.n;

@@ -51,6 +51,8 @@
 #define SPHERE_UNROLL
 #endif
 
+/// SPHERE_DEVICE_CODE: 1 in nvcc's device pass, else 0, for the few places where a GPU thread
+/// and a host SIMD lane want different forms of the same arithmetic.
 #if defined(__CUDA_ARCH__)
 #define SPHERE_DEVICE_CODE 1
 #else

@@ -44,11 +44,19 @@ struct alignas(4 * sizeof(Real)) vec4 {
     SPHERE_HDI vec3<Real> xyz() const { return {x, y, z}; }
 };
 
-template <class Real> SPHERE_HDI vec3<Real> operator+(vec3<Real> a, const vec3<Real>& b) { return a += b; }
-template <class Real> SPHERE_HDI vec3<Real> operator-(vec3<Real> a, const vec3<Real>& b) { return a -= b; }
+// Operands by reference and results built by component: a vec3<float> copied whole is loaded
+// by clang as two floats in one vector and a third, which its loop vectoriser refuses.
+template <class Real> SPHERE_HDI vec3<Real> operator+(const vec3<Real>& a, const vec3<Real>& b)
+{
+    return {a.x + b.x, a.y + b.y, a.z + b.z};
+}
+template <class Real> SPHERE_HDI vec3<Real> operator-(const vec3<Real>& a, const vec3<Real>& b)
+{
+    return {a.x - b.x, a.y - b.y, a.z - b.z};
+}
 template <class Real> SPHERE_HDI vec3<Real> operator-(const vec3<Real>& a) { return {-a.x, -a.y, -a.z}; }
-template <class Real> SPHERE_HDI vec3<Real> operator*(vec3<Real> a, Real s) { return a *= s; }
-template <class Real> SPHERE_HDI vec3<Real> operator*(Real s, vec3<Real> a) { return a *= s; }
+template <class Real> SPHERE_HDI vec3<Real> operator*(const vec3<Real>& a, Real s) { return {a.x * s, a.y * s, a.z * s}; }
+template <class Real> SPHERE_HDI vec3<Real> operator*(Real s, const vec3<Real>& a) { return {a.x * s, a.y * s, a.z * s}; }
 template <class Real> SPHERE_HDI vec3<Real> operator/(const vec3<Real>& a, Real s) { return {a.x / s, a.y / s, a.z / s}; }
 template <class Real> SPHERE_HDI bool operator==(const vec3<Real>& a, const vec3<Real>& b)
 {
