@@ -3,6 +3,7 @@
 # Idempotent: installs only what is missing, and runs `apt-get update` only
 # when something is missing. Uses sudo when not run as root.
 #
+# Arguments name further packages to install the same way (scripts/check-clang.sh: clang).
 # Set SPHERE_SKIP_DEPS=1 to skip this step entirely.
 set -euo pipefail
 
@@ -17,6 +18,7 @@ packages=(
     python3-vtk9 python3-matplotlib python3-numpy
     libpng-dev python3-pil
     pybind11-dev python3-pybind11 python3-pytest python3-dev python3-pip
+    "$@"
 )
 
 # Thrust/CUB headers: the CUDA toolkit ships them; otherwise use Debian's.
