@@ -53,9 +53,9 @@ struct zero_pair_sums {
 /// (contact/history.cuh).
 template <class Real, unsigned Lanes>
 struct pair_tile {
-    /// 16 doubles or 32 floats: two AVX-512 vectors (16 floats were 7% slower in mixed on the
-    /// dense bed, docs/performance.md)
-    static constexpr int width = 128 / sizeof(Real);
+    /// 64 doubles or 128 floats: eight AVX-512 vectors (on the dense bed 0-5% faster than two,
+    /// and two floats' vectors 7% faster than one; docs/performance.md)
+    static constexpr int width = 512 / sizeof(Real);
     int count = 0;
     unsigned owner[width], partner[width], entry[width];
     Real dx[width], dy[width], dz[width], r_i[width], r_j[width], excess[width]; ///< pair_separation
