@@ -53,8 +53,9 @@ struct zero_pair_sums {
 /// (contact/history.cuh).
 template <class Real, unsigned Lanes>
 struct pair_tile {
-    /// 64 doubles or 128 floats: eight AVX-512 vectors (on the dense bed 0-5% faster than two,
-    /// and two floats' vectors 7% faster than one; docs/performance.md)
+    /// 64 doubles or 128 floats: eight AVX-512 vectors. On the dense bed, tiles of eight
+    /// vectors were 0-5% faster than tiles of two, and in mixed two were 7% faster than one
+    /// (docs/performance.md).
     static constexpr int width = 512 / sizeof(Real);
     int count = 0;
     unsigned owner[width], partner[width], entry[width];
