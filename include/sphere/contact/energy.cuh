@@ -84,7 +84,7 @@ struct particle_energy {
             pair_separation<Real> s;
             if (!separate<Law>(pair_params, box, xi, p.x[j], s)) return;
             contact_geometry<Real> g;
-            pair_geometry<materials>(g, p, i, j, s);
+            pair_geometry<materials>(g, p, i, j, s, p.mass[i], p.mass[j]);
             law_history_t<Law, Real> h{}; // a far row's entry without a history has none
             if (c.has_history(k)) c.history.load(k, h);
             e.elastic += Coord(Law::pair_energy(pair_params, g, h));

@@ -107,19 +107,19 @@ SPHERE_HDI bool separate(const KernelParams& params, const world<Coord>& box, co
     return law_acts<Law>(params, dist2, xi.w + xj.w);
 }
 
-/// Fills the geometry g of the contact of particles i and j of p, as seen by i, from their
-/// separation s; with `Materials` (a law that tells materials apart, contact/law.cuh) their
-/// material indices too, else 0.
+/// Fills the geometry g of the contact of particles i and j of p (masses m_i and m_j), as seen
+/// by i, from their separation s; with `Materials` (a law that tells materials apart,
+/// contact/law.cuh) their material indices too, else 0.
 template <bool Materials, class P>
 SPHERE_HDI void pair_geometry(contact_geometry<real_t<P>>& g, const particle_view<P>& p, std::size_t i, std::size_t j,
-                              const pair_separation<real_t<P>>& s)
+                              const pair_separation<real_t<P>>& s, real_t<P> m_i, real_t<P> m_j)
 {
     g.delta_n = overlap_and_normal<coord_t<P>>(s, g.n);
     g.r_i = s.r_i;
     g.r_j = s.r_j;
     g.r_eff = g.r_i * g.r_j / (g.r_i + g.r_j);
-    g.m_i = p.mass[i];
-    g.m_j = p.mass[j];
+    g.m_i = m_i;
+    g.m_j = m_j;
     g.m_eff = g.m_i * g.m_j / (g.m_i + g.m_j);
     g.material_i = Materials ? p.material[i] : 0u;
     g.material_j = Materials ? p.material[j] : 0u;
@@ -141,6 +141,19 @@ SPHERE_HDI void wall_geometry(contact_geometry<real_t<P>>& g, const particle_vie
     g.material_i = Materials ? p.material[i] : 0u;
     g.material_j = static_cast<unsigned>(f);
 }
+
+/// What a pair contact reads of particle i's motion, from p: its velocity (m/s) and angular
+/// velocity (rad/s) at the positions' time (v_sync, omega_sync), and its mass (kg). Read
+/// where the law needs them, as the law's own loads would be (a copy into a struct first made
+/// g++ vectorise the host's tiles worse in double: docs/performance.md, *Records in float*).
+template <class P>
+struct stored_motion {
+    const particle_view<P>& p;
+    std::size_t i;
+    SPHERE_HDI vec3<real_t<P>> v() const { return p.v_sync[i]; }
+    SPHERE_HDI vec3<real_t<P>> omega() const { return p.omega_sync[i]; }
+    SPHERE_HDI real_t<P> mass() const { return p.mass[i]; }
+};
 
 /// One evaluated pair contact, for its owner i and its partner j.
 template <class Real>
@@ -213,15 +226,25 @@ struct pair_contact {
     SPHERE_HDI pair_result<Real> evaluate_touching(std::size_t i, std::size_t j, const pair_separation<Real>& s,
                                                    history_type& h) const
     {
+        return evaluate_moving(i, j, stored_motion<P>{p, i}, stored_motion<P>{p, j}, s, h);
+    }
+
+    /// evaluate_touching with the particles' motions read from mi and mj (stored_motion's
+    /// interface): the host's tiles move them into the lanes as records in float
+    /// (contact/interact.cuh).
+    template <class MotionI, class MotionJ>
+    SPHERE_HDI pair_result<Real> evaluate_moving(std::size_t i, std::size_t j, const MotionI& mi, const MotionJ& mj,
+                                                 const pair_separation<Real>& s, history_type& h) const
+    {
         contact_motion<Real> m;
-        pair_geometry<materials>(m, p, i, j, s);
+        pair_geometry<materials>(m, p, i, j, s, mi.mass(), mj.mass());
         vec3<Real> n = m.n; // not const: see the note at the top
         const Real arm_i = s.r_i + m.delta_n / 2, arm_j = s.r_j + m.delta_n / 2;
-        m.velocity = p.v_sync[i] - p.v_sync[j] + arm_i * cross(n, p.omega_sync[i]) + arm_j * cross(n, p.omega_sync[j]);
+        m.velocity = mi.v() - mj.v() + arm_i * cross(n, mi.omega()) + arm_j * cross(n, mj.omega());
         m.step = OneVelocity ? m.velocity * dt
                              : (p.v[i] - p.v[j]) * dt + arm_i * cross(n, p.omega[i] * dt) +
                                    arm_j * cross(n, p.omega[j] * dt);
-        m.spin = p.omega_sync[i] - p.omega_sync[j];
+        m.spin = mi.omega() - mj.omega();
         m.spin_step = OneVelocity ? m.spin * dt : (p.omega[i] - p.omega[j]) * dt;
         history_type updated = h;
         contact_result<Real> c = Law::pair(params, m, updated, dt);

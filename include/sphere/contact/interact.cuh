@@ -21,6 +21,7 @@
 #include "../exec/context.cuh"
 #include "../exec/for_each.cuh"
 #include "../exec/host_team.cuh"
+#include "../exec/lane_records.cuh"
 #include "../exec/policy.cuh"
 #include "contact_lists.cuh"
 #include "evaluate.cuh"
@@ -29,15 +30,33 @@
 namespace sphere {
 namespace detail {
 
-/// Zeroes what the pair sums accumulate into: force, torque and, with Book, the audit sums.
+/// Whether the slab schedule keeps each particle's motion (v_sync, mass, omega_sync: stored_motion)
+/// and its sums of force and torque as records of eight floats, which its tiles move as
+/// vectors (exec/lane_records.cuh): a law in float on a host compiled for AVX-512. 64 B per
+/// particle more (docs/performance.md, *Records in float*).
+template <class Real>
+inline constexpr bool sums_in_records = std::is_same_v<Real, float> && lane_records_native;
+
+/// Zeroes what the pair sums accumulate into: force, torque and, with Book, the audit sums;
+/// with sums_in_records, the sums' records instead of force and torque, and the motion's
+/// records are written.
 template <class P, bool Book>
 struct zero_pair_sums {
     particle_view<P> p;
+    record8* motion; ///< with sums_in_records
+    record8* sums;   ///< with sums_in_records
     SPHERE_HDI void operator()(std::size_t i) const
     {
         using Real = real_t<P>;
-        p.force[i] = vec3<Real>{0, 0, 0};
-        p.torque[i] = vec3<Real>{0, 0, 0};
+        if constexpr (sums_in_records<Real>) {
+#ifdef SPHERE_LANE_RECORDS
+            lanes::pack(motion[i], p.v_sync[i], p.mass[i], p.omega_sync[i]);
+            sums[i] = record8{};
+#endif
+        } else {
+            p.force[i] = vec3<Real>{0, 0, 0};
+            p.torque[i] = vec3<Real>{0, 0, 0};
+        }
         if (Book) {
             p.pressure[i] = 0;
             p.p_visc[i] = 0;
@@ -50,7 +69,8 @@ struct zero_pair_sums {
 /// the rest repeat lane 0 and are discarded. The row walk fills in each pair's separation and
 /// radii, which it has read to sort out pairs apart, so that the SIMD loop does not gather the
 /// positions again. `Lanes`: the contact law's history lanes
-/// (contact/history.cuh).
+/// (contact/history.cuh). With sums_in_records, the flush moves both particles' motion records
+/// and the entries' tangential displacements into lanes before the SIMD loop.
 template <class Real, unsigned Lanes>
 struct pair_tile {
     /// 64 doubles or 128 floats: eight AVX-512 vectors. On the dense bed, tiles of eight
@@ -66,6 +86,9 @@ struct pair_tile {
     Real hl[Lanes > 0 ? Lanes : 1][width];
     Real fn[width], visc[width], fric[width];
     Real rx[width], ry[width], rz[width], rw[width];
+    static constexpr int record_width = sums_in_records<Real> ? width : 1;
+    float motion_i[8][record_width], motion_j[8][record_width]; ///< motion records, value by value
+    float shift[3][record_width];                               ///< tangential displacements
 };
 
 /// The pair sums of the host's slab schedule, for the owners of a range of ranks: pairs are
@@ -79,8 +102,25 @@ struct slab_pairs {
     using Real = real_t<P>;
     pair_contact<P, Law, OneVelocity> eval;
     contact_view<Real> c;
+    const record8* motion; ///< with sums_in_records (zero_pair_sums)
+    record8* sums;         ///< with sums_in_records
     bool update_history;
     bool near_only;
+
+    /// With sums_in_records, copies the sums of the particles of ranks [first_rank, end_rank)
+    /// into their force and torque (after the pair sums, before what reads them).
+    void store_sums(unsigned first_rank, unsigned end_rank) const
+    {
+        if constexpr (sums_in_records<Real>) {
+            const particle_view<P>& p = eval.p;
+            for (unsigned r = first_rank; r < end_rank; ++r) {
+                const std::size_t i = c.slot(r);
+                const float* s = sums[i].value;
+                p.force[i] = {s[0], s[1], s[2]};
+                p.torque[i] = {s[3], s[4], s[5]};
+            }
+        }
+    }
 
     void operator()(unsigned first_rank, unsigned end_rank) const
     {
@@ -145,6 +185,7 @@ private:
     using history_type = law_history_t<Law, Real>;
     static constexpr unsigned lanes = law_history_shape<Law>::value.lanes;
     using tile = pair_tile<Real, lanes>;
+    static constexpr bool records = sums_in_records<Real>;
 
     /// The entries of pairs that do not touch: no force, and the history is forgotten.
     void forget(const unsigned* entry, int& count) const
@@ -175,9 +216,18 @@ private:
         pair_contact<P, Law, OneVelocity> pairs = eval;
         const vec3<Real>* shift = c.history.shift;
         const Real* lane = c.history.lane;
+#ifdef SPHERE_LANE_RECORDS
+        if constexpr (records) {
+            lanes::gather_records(motion, t.owner, t.motion_i);
+            lanes::gather_records(motion, t.partner, t.motion_j);
+            lanes::gather_vec3(shift, t.entry, t.shift);
+        }
+#endif
         SPHERE_VECTORISE_LOOP
         for (int k = 0; k < w; ++k) {
-            const vec3<Real> s = shift[t.entry[k]];
+            vec3<Real> s;
+            if constexpr (records) s = {t.shift[0][k], t.shift[1][k], t.shift[2][k]};
+            else s = shift[t.entry[k]];
             history_type h;
             history_base(h) = {s.x, s.y, s.z, t.hw[k]};
             if constexpr (lanes > 0)
@@ -187,7 +237,10 @@ private:
             sep.r_i = t.r_i[k];
             sep.r_j = t.r_j[k];
             sep.excess = wide ? t.excess[k] : Real(0);
-            pair_result<Real> r = pairs.evaluate_touching(t.owner[k], t.partner[k], sep, h);
+            pair_result<Real> r;
+            if constexpr (records)
+                r = pairs.evaluate_moving(t.owner[k], t.partner[k], lane_motion{t.motion_i, k}, lane_motion{t.motion_j, k}, sep, h);
+            else r = pairs.evaluate_touching(t.owner[k], t.partner[k], sep, h);
             t.fx[k] = r.force.x;
             t.fy[k] = r.force.y;
             t.fz[k] = r.force.z;
@@ -225,11 +278,13 @@ private:
                     for (unsigned l = 0; l < lanes; ++l) c.history.lane[e * lanes + l] = t.hl[l][k];
             }
             if (Record) c.force[e] = {t.rx[k], t.ry[k], t.rz[k], t.rw[k]};
-            const vec3<Real> f{t.fx[k], t.fy[k], t.fz[k]};
-            p.force[i] += f;
-            p.force[j] -= f;
-            p.torque[i] += vec3<Real>{t.tix[k], t.tiy[k], t.tiz[k]};
-            p.torque[j] += vec3<Real>{t.tjx[k], t.tjy[k], t.tjz[k]};
+            if constexpr (!records) {
+                const vec3<Real> f{t.fx[k], t.fy[k], t.fz[k]};
+                p.force[i] += f;
+                p.force[j] -= f;
+                p.torque[i] += vec3<Real>{t.tix[k], t.tiy[k], t.tiz[k]};
+                p.torque[j] += vec3<Real>{t.tjx[k], t.tjy[k], t.tjz[k]};
+            }
             if (Book) {
                 p.pressure[i] += t.fn[k];
                 p.pressure[j] += t.fn[k];
@@ -239,8 +294,23 @@ private:
                 p.p_fric[j] += t.fric[k];
             }
         }
+#ifdef SPHERE_LANE_RECORDS
+        if constexpr (records)
+            lanes::add_pair_shares(sums, t.owner, t.partner, {t.fx, t.fy, t.fz}, {t.tix, t.tiy, t.tiz},
+                                   {t.tjx, t.tjy, t.tjz}, t.count);
+#endif
         t.count = 0;
     }
+
+    /// Lane k's motion from the values of its record (stored_motion's interface; zero_pair_sums
+    /// packs v_sync, mass, omega_sync).
+    struct lane_motion {
+        const float (*m)[tile::record_width];
+        int k;
+        vec3<float> v() const { return {m[0][k], m[1][k], m[2][k]}; }
+        vec3<float> omega() const { return {m[4][k], m[5][k], m[6][k]}; }
+        float mass() const { return m[3][k]; }
+    };
 };
 
 /// The two phases of the slab schedule: tasks of grid layers whose owners write disjoint sets
@@ -345,6 +415,7 @@ void slab_share(const Pairs& pairs, const Zero& zero, const Finish& finish, std:
     }
     unsigned lo, hi;
     phases.block(t, threads, lo, hi);
+    pairs.store_sums(layer_start[lo], layer_start[hi]);
     finish(layer_start[lo], layer_start[hi], t);
 }
 
@@ -530,8 +601,14 @@ public:
         if (resolve(how) == pair_summation::slabs) {
             if constexpr (runs_in_blocks<Policy>) {
                 const detail::slab_phases phases(lists.layer_entries(), lists.periodic_layers());
-                detail::sum_by_slabs(detail::slab_pairs<P, Law, Book, Record, OneVelocity>{eval, c, update_history, near_only},
-                                     detail::zero_pair_sums<P, Book>{p}, finish, p.n, lists.layer_start(), phases);
+                if (detail::sums_in_records<Real> && motion_.size() < p.n) {
+                    motion_.resize(p.n);
+                    sums_.resize(p.n);
+                }
+                detail::sum_by_slabs(detail::slab_pairs<P, Law, Book, Record, OneVelocity>{eval, c, motion_.data(), sums_.data(),
+                                                                                          update_history, near_only},
+                                     detail::zero_pair_sums<P, Book>{p, motion_.data(), sums_.data()}, finish, p.n,
+                                     lists.layer_start(), phases);
             }
             walked_near_ = near_only;
             return true;
@@ -579,6 +656,7 @@ private:
     }
 
     buffer<vec3<Real>, Policy> force_, torque_i_, torque_j_, audit_;
+    buffer<record8, Policy> motion_, sums_; ///< the slab schedule's records (detail::sums_in_records)
     buffer<unsigned, Policy> reverse_offset_, reverse_key_, reverse_entry_;
     bool reverse_ready_ = false;
     bool results_walked_ = false; ///< every entry's result stored since the lists changed (gather)
