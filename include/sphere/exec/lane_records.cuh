@@ -2,8 +2,8 @@
 /// \file
 /// Records of eight floats (32 B, one 256-bit register) moved between per-particle arrays and
 /// the lanes of the host's SIMD tiles by AVX-512 shuffles, where a loop the compiler vectorises
-/// would load or add each value on its own: a tile of 16 lanes takes 16 loads of a record and
-/// 24 shuffles for its 128 values instead of 128 loads and 128 inserts
+/// would load or add each value on its own: 16 lanes' records take 16 loads and 32 shuffles
+/// for their 128 values instead of 128 loads and 128 inserts
 /// (docs/performance.md, *Records in float*). They exist only where the host compiler targets
 /// AVX-512 (`lane_records_native`, SPHERE_LANE_RECORDS); elsewhere the tiles move value by
 /// value (contact/interact.cuh).
