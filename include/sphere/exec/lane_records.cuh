@@ -41,6 +41,18 @@ namespace lanes {
 /// The lanes of a tile hold 16 floats per AVX-512 register: W (the tile's width) is a multiple.
 inline constexpr int block = 16;
 
+/// A 4x4 transposition inside each 128-bit lane q of four registers: position r of out[c]'s
+/// lane q is position c of in[r]'s lane q.
+inline void transpose_in_lanes(const __m512 (&in)[4], __m512 (&out)[4])
+{
+    const __m512 low01 = _mm512_unpacklo_ps(in[0], in[1]), high01 = _mm512_unpackhi_ps(in[0], in[1]);
+    const __m512 low23 = _mm512_unpacklo_ps(in[2], in[3]), high23 = _mm512_unpackhi_ps(in[2], in[3]);
+    out[0] = _mm512_shuffle_ps(low01, low23, 0x44);
+    out[1] = _mm512_shuffle_ps(low01, low23, 0xEE);
+    out[2] = _mm512_shuffle_ps(high01, high23, 0x44);
+    out[3] = _mm512_shuffle_ps(high01, high23, 0xEE);
+}
+
 /// lanes[f][k] = records[index[k]].value[f] for f < 8 and k < W.
 template <int W>
 void gather_records(const record8* records, const unsigned* index, float (*lanes)[W])
@@ -50,26 +62,18 @@ void gather_records(const record8* records, const unsigned* index, float (*lanes
         const unsigned* ix = index + k0;
         // z[m] holds the records of lanes m and m + 4 (m < 4) or m + 4 and m + 8 (m >= 4), so
         // that the transposition below leaves lane k in position k of each field's register
-        __m512 z[8];
+        __m512 z[2][4];
         for (int m = 0; m < 8; ++m) {
             const int lo = m < 4 ? m : m + 4;
-            z[m] = _mm512_insertf32x8(_mm512_castps256_ps512(_mm256_load_ps(records[ix[lo]].value)),
-                                      _mm256_load_ps(records[ix[lo + 4]].value), 1);
+            z[m / 4][m % 4] = _mm512_insertf32x8(_mm512_castps256_ps512(_mm256_load_ps(records[ix[lo]].value)),
+                                                 _mm256_load_ps(records[ix[lo + 4]].value), 1);
         }
-        __m512 a[8], b[8];
-        for (int m = 0; m < 8; m += 2) {
-            a[m] = _mm512_unpacklo_ps(z[m], z[m + 1]);
-            a[m + 1] = _mm512_unpackhi_ps(z[m], z[m + 1]);
-        }
-        for (int m = 0; m < 8; m += 4) { // b[m + f]: value f (128-bit lanes 0, 2) and f + 4 (1, 3)
-            b[m] = _mm512_shuffle_ps(a[m], a[m + 2], 0x44);
-            b[m + 1] = _mm512_shuffle_ps(a[m], a[m + 2], 0xEE);
-            b[m + 2] = _mm512_shuffle_ps(a[m + 1], a[m + 3], 0x44);
-            b[m + 3] = _mm512_shuffle_ps(a[m + 1], a[m + 3], 0xEE);
-        }
+        __m512 b[2][4]; // b[h][f]: value f (128-bit lanes 0, 2) and f + 4 (1, 3)
+        transpose_in_lanes(z[0], b[0]);
+        transpose_in_lanes(z[1], b[1]);
         for (int f = 0; f < 4; ++f) {
-            _mm512_storeu_ps(&lanes[f][k0], _mm512_shuffle_f32x4(b[f], b[f + 4], 0x88));
-            _mm512_storeu_ps(&lanes[f + 4][k0], _mm512_shuffle_f32x4(b[f], b[f + 4], 0xDD));
+            _mm512_storeu_ps(&lanes[f][k0], _mm512_shuffle_f32x4(b[0][f], b[1][f], 0x88));
+            _mm512_storeu_ps(&lanes[f + 4][k0], _mm512_shuffle_f32x4(b[0][f], b[1][f], 0xDD));
         }
     }
 }
@@ -88,11 +92,9 @@ void gather_vec3(const vec3<float>* from, const unsigned* index, float (*lanes)[
             v = _mm512_insertf32x4(v, _mm_maskz_loadu_ps(0x7, &from[ix[m + 8]].x), 2);
             z[m] = _mm512_insertf32x4(v, _mm_maskz_loadu_ps(0x7, &from[ix[m + 12]].x), 3);
         }
-        const __m512 a0 = _mm512_unpacklo_ps(z[0], z[1]), a1 = _mm512_unpackhi_ps(z[0], z[1]);
-        const __m512 a2 = _mm512_unpacklo_ps(z[2], z[3]), a3 = _mm512_unpackhi_ps(z[2], z[3]);
-        _mm512_storeu_ps(&lanes[0][k0], _mm512_shuffle_ps(a0, a2, 0x44));
-        _mm512_storeu_ps(&lanes[1][k0], _mm512_shuffle_ps(a0, a2, 0xEE));
-        _mm512_storeu_ps(&lanes[2][k0], _mm512_shuffle_ps(a1, a3, 0x44));
+        __m512 xyz[4];
+        transpose_in_lanes(z, xyz);
+        for (int c = 0; c < 3; ++c) _mm512_storeu_ps(&lanes[c][k0], xyz[c]);
     }
 }
 
@@ -100,27 +102,19 @@ void gather_vec3(const vec3<float>* from, const unsigned* index, float (*lanes)[
 /// out[l]; `negate`: the first three values negated.
 inline void lanes_to_records(const float* const (&from)[6], int k0, bool negate, __m256 (&out)[block])
 {
-    __m512 v[8];
-    for (int m = 0; m < 6; ++m) v[m] = _mm512_loadu_ps(from[m] + k0);
+    __m512 v[2][4];
+    for (int m = 0; m < 6; ++m) v[m / 4][m % 4] = _mm512_loadu_ps(from[m] + k0);
     if (negate) // by the sign bit, as unary minus: -0 stays distinct from 0
-        for (int m = 0; m < 3; ++m) v[m] = _mm512_xor_ps(v[m], _mm512_set1_ps(-0.0f));
-    v[6] = v[7] = _mm512_setzero_ps();
-    __m512 a[8], c[8];
-    for (int m = 0; m < 8; m += 2) {
-        a[m] = _mm512_unpacklo_ps(v[m], v[m + 1]);
-        a[m + 1] = _mm512_unpackhi_ps(v[m], v[m + 1]);
-    }
-    for (int m = 0; m < 8; m += 4) { // c[m + r], 128-bit lane q: values m .. m + 3 of lane 4 q + r
-        c[m] = _mm512_shuffle_ps(a[m], a[m + 2], 0x44);
-        c[m + 1] = _mm512_shuffle_ps(a[m], a[m + 2], 0xEE);
-        c[m + 2] = _mm512_shuffle_ps(a[m + 1], a[m + 3], 0x44);
-        c[m + 3] = _mm512_shuffle_ps(a[m + 1], a[m + 3], 0xEE);
-    }
+        for (int m = 0; m < 3; ++m) v[0][m] = _mm512_xor_ps(v[0][m], _mm512_set1_ps(-0.0f));
+    v[1][2] = v[1][3] = _mm512_setzero_ps();
+    __m512 c[2][4]; // c[h][r], 128-bit lane q: values 4 h .. 4 h + 3 of lane 4 q + r
+    transpose_in_lanes(v[0], c[0]);
+    transpose_in_lanes(v[1], c[1]);
     const __m512i first = _mm512_set_epi32(23, 22, 21, 20, 7, 6, 5, 4, 19, 18, 17, 16, 3, 2, 1, 0);
     const __m512i second = _mm512_set_epi32(31, 30, 29, 28, 15, 14, 13, 12, 27, 26, 25, 24, 11, 10, 9, 8);
     for (int r = 0; r < 4; ++r) {
-        const __m512 lanes_r = _mm512_permutex2var_ps(c[r], first, c[r + 4]);   // lanes r, r + 4
-        const __m512 lanes_r8 = _mm512_permutex2var_ps(c[r], second, c[r + 4]); // lanes r + 8, r + 12
+        const __m512 lanes_r = _mm512_permutex2var_ps(c[0][r], first, c[1][r]);   // lanes r, r + 4
+        const __m512 lanes_r8 = _mm512_permutex2var_ps(c[0][r], second, c[1][r]); // lanes r + 8, r + 12
         out[r] = _mm512_castps512_ps256(lanes_r);
         out[r + 4] = _mm512_extractf32x8_ps(lanes_r, 1);
         out[r + 8] = _mm512_castps512_ps256(lanes_r8);
