@@ -60,8 +60,8 @@ void gather_records(const record8* records, const unsigned* index, float (*lanes
     static_assert(W % block == 0, "a tile is whole registers of 16 lanes");
     for (int k0 = 0; k0 < W; k0 += block) {
         const unsigned* ix = index + k0;
-        // z[m] holds the records of lanes m and m + 4 (m < 4) or m + 4 and m + 8 (m >= 4), so
-        // that the transposition below leaves lane k in position k of each field's register
+        // z[h][m] holds the records of lanes 8 h + m and 8 h + m + 4, so that the
+        // transposition below leaves lane k in position k of each field's register
         __m512 z[2][4];
         for (int m = 0; m < 8; ++m) {
             const int lo = m < 4 ? m : m + 4;
