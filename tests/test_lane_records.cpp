@@ -1,11 +1,14 @@
-// Records of eight floats moved into and out of the host tiles' lanes (exec/lane_records.cuh):
-// each function against the value-by-value loop it replaces, to the bit. The simulations'
-// tests cover their use (in float and mixed the slab schedule's sums are these records:
-// test_determinism compares them with the gather schedule, which does not use them).
+// Records of eight floats moved into and out of the host tiles' lanes (exec/lane_records.cuh),
+// and the row walk in lanes (contact/separation_lanes.cuh): each function against the
+// value-by-value loop it replaces, to the bit. The simulations' tests cover their use (in
+// float and mixed the slab schedule's sums are these records, in double and mixed its walk is
+// in lanes: test_determinism compares them with the gather schedule, which uses neither).
 #include <catch2/catch.hpp>
 
 #include <sphere/dem.cuh>
 
+#include <algorithm>
+#include <cstdint>
 #include <cstring>
 #include <random>
 #include <vector>
@@ -120,6 +123,154 @@ TEST_CASE("pair shares added as records are the scalar sums' bits, in lane order
     CHECK(wrong == 0);
 }
 
+namespace {
+
+/// A law that acts up to `gap` apart (as a liquid bridge does), and one that acts in contact.
+struct bridge_law {
+    static constexpr bool acts_apart = true;
+    template <class Params>
+    static double range(const Params& p)
+    {
+        return p.gap;
+    }
+};
+struct contact_law {};
+struct gap_params {
+    double gap;
+};
+
+template <class T>
+bool same_value_bits(T a, T b)
+{
+    return std::memcmp(&a, &b, sizeof a) == 0;
+}
+
+/// Rows of 1 to 17 entries of random partners among particles in a box periodic in x and y
+/// (many near its faces, some at the same place as the owner, rows ending with wall codes),
+/// walked by lanes::separate_block and by separate<Law> entry by entry: the same lanes, apart
+/// entries and counts, to the bit, across tile flushes.
+template <class Law, class Real>
+void check_row_walk(const gap_params& params, std::uint32_t seed)
+{
+    std::mt19937 rng(seed);
+    sphere::world<double> box;
+    box.lo = {-0.01, 0.0, 0.0};
+    box.hi = {0.04, 0.05, 0.03};
+    box.axis[0] = box.axis[1] = sphere::boundary::periodic;
+    constexpr int n = 300;
+    std::vector<sphere::vec4<double>> x(n);
+    std::uniform_real_distribution<double> unit(0.0, 1.0), radius(0.0009, 0.0011);
+    for (auto& p : x) {
+        for (int a = 0; a < 3; ++a) {
+            // a third of the coordinates within two diameters of a face
+            const double u = unit(rng), l = box.hi[a] - box.lo[a];
+            const double f = u < 1.0 / 6 ? u * 0.0024 / l * 6 : (u > 5.0 / 6 ? 1 - (1 - u) * 0.0024 / l * 6 : u);
+            (a == 0 ? p.x : a == 1 ? p.y : p.z) = box.lo[a] + f * l;
+        }
+        p.w = radius(rng);
+    }
+    // partners near their owners, so that many pairs touch or nearly do
+    std::vector<unsigned> partner;
+    std::vector<std::uint8_t> flags;
+    std::vector<unsigned> owner_of_row, row_start;
+    std::uniform_int_distribution<int> length(1, 17), walls(0, 3), any(0, n - 1), flag(0, 255);
+    for (int row = 0; row < 1500; ++row) {
+        const unsigned i = unsigned(any(rng));
+        owner_of_row.push_back(i);
+        row_start.push_back(unsigned(partner.size()));
+        const int len = length(rng), wall_count = walls(rng) == 0 ? 2 : 0;
+        for (int k = 0; k < len; ++k) {
+            const unsigned j = unsigned(any(rng));
+            if (k % 3 != 0) { // place j touching i (its image across a face, where i lies near one)
+                const double gap = (unit(rng) - 0.7) * 0.0003, reach = x[i].w + x[j].w + gap;
+                sphere::vec3<double> dir{unit(rng) - 0.5, unit(rng) - 0.5, unit(rng) - 0.5};
+                dir = dir * (reach / sphere::norm(dir));
+                x[j] = {box.wrap(x[i].x + dir.x, 0), box.wrap(x[i].y + dir.y, 1), x[i].z + dir.z, x[j].w};
+            }
+            if (k == 4) x[j] = {x[i].x, x[i].y, x[i].z, x[j].w}; // coincident centres: never a pair
+            partner.push_back(j);
+            flags.push_back(std::uint8_t(flag(rng)));
+        }
+        for (int f = 0; f < wall_count; ++f) {
+            partner.push_back(sphere::wall_partner_base + unsigned(f));
+            flags.push_back(0);
+        }
+    }
+    row_start.push_back(unsigned(partner.size()));
+
+    using tile = sphere::detail::pair_tile<Real, 0>;
+    constexpr bool wide = !std::is_same_v<Real, double>;
+    tile t;
+    std::vector<unsigned> apart(tile::width + tile::overflow);
+    int apart_count = 0;
+    // the reference: entry by entry, as the scalar walk fills the tile
+    std::vector<unsigned> ref_entry, ref_apart, got_entry, got_apart;
+    std::vector<Real> ref_values, got_values;
+    const auto take_tile = [&](int count, std::vector<unsigned>& entries, std::vector<Real>& values) {
+        for (int k = 0; k < count; ++k) {
+            entries.insert(entries.end(), {t.owner[k], t.partner[k], t.entry[k]});
+            values.insert(values.end(), {t.hw[k], t.dx[k], t.dy[k], t.dz[k], t.r_i[k], t.r_j[k]});
+            if (wide) values.push_back(t.excess[k]);
+        }
+    };
+    for (std::size_t row = 0; row + 1 < row_start.size(); ++row) {
+        const unsigned i = owner_of_row[row];
+        for (unsigned e = row_start[row]; e < row_start[row + 1]; ++e) {
+            const unsigned j = partner[e];
+            if (j >= sphere::wall_partner_base) break;
+            sphere::detail::pair_separation<Real> s;
+            if (sphere::detail::separate<Law, true>(params, box, x[i], x[j], s)) {
+                ref_entry.insert(ref_entry.end(), {i, j, e});
+                ref_values.insert(ref_values.end(), {Real(flags[e]), s.d.x, s.d.y, s.d.z, s.r_i, s.r_j});
+                if (wide) ref_values.push_back(s.excess);
+            } else ref_apart.push_back(e);
+        }
+        // the lanes, flushed as the slab schedule flushes them
+        for (unsigned e = row_start[row]; e < row_start[row + 1]; e += 8) {
+            const int lanes = int(std::min(8u, row_start[row + 1] - e));
+            sphere::lanes::separate_block<Law, wide>(params, box, x.data(), partner.data(), flags.data(), i, x[i], e,
+                                                     lanes, t, apart.data(), apart_count);
+            if (apart_count >= tile::width) {
+                got_apart.insert(got_apart.end(), apart.begin(), apart.begin() + apart_count);
+                apart_count = 0;
+            }
+            if (t.count >= tile::width) {
+                take_tile(tile::width, got_entry, got_values);
+                const int over = t.count - tile::width;
+                for (int k = 0; k < over; ++k) {
+                    const int from = tile::width + k;
+                    t.owner[k] = t.owner[from], t.partner[k] = t.partner[from], t.entry[k] = t.entry[from];
+                    t.hw[k] = t.hw[from], t.dx[k] = t.dx[from], t.dy[k] = t.dy[from], t.dz[k] = t.dz[from];
+                    t.r_i[k] = t.r_i[from], t.r_j[k] = t.r_j[from], t.excess[k] = t.excess[from];
+                }
+                t.count = over;
+            }
+        }
+    }
+    take_tile(t.count, got_entry, got_values);
+    got_apart.insert(got_apart.end(), apart.begin(), apart.begin() + apart_count);
+    // both outcomes are common, and the lists are long enough to flush several tiles
+    CHECK(ref_entry.size() / 3 > std::size_t(2 * tile::width));
+    CHECK(ref_apart.size() > std::size_t(2 * tile::width));
+    CHECK(got_entry == ref_entry);
+    CHECK(got_apart == ref_apart);
+    REQUIRE(got_values.size() == ref_values.size());
+    int wrong = 0;
+    for (std::size_t k = 0; k < ref_values.size(); ++k) wrong += !same_value_bits(got_values[k], ref_values[k]);
+    CHECK(wrong == 0);
+}
+
+} // namespace
+
+TEST_CASE("the row walk in lanes gives the scalar walk's lanes to the bit", "[lane_records]")
+{
+    STATIC_REQUIRE(sphere::row_walk_in_lanes<double>);
+    STATIC_REQUIRE(!sphere::row_walk_in_lanes<float>);
+    SECTION("double") { check_row_walk<contact_law, double>({0.0}, 11); }
+    SECTION("mixed") { check_row_walk<contact_law, float>({0.0}, 12); }
+    SECTION("a law that acts apart, mixed") { check_row_walk<bridge_law, float>({0.0002}, 13); }
+}
+
 #else
 
 TEST_CASE("without AVX-512 the tiles move values one by one", "[lane_records]")
@@ -128,6 +279,7 @@ TEST_CASE("without AVX-512 the tiles move values one by one", "[lane_records]")
     // keeps the sums in force and torque in every precision
     STATIC_REQUIRE(!sphere::lane_records_native);
     STATIC_REQUIRE(!sphere::detail::sums_in_records<float>);
+    STATIC_REQUIRE(!sphere::row_walk_in_lanes<double>);
 }
 
 #endif

@@ -25,6 +25,7 @@
 #include "../exec/policy.cuh"
 #include "contact_lists.cuh"
 #include "evaluate.cuh"
+#include "separation_lanes.cuh"
 #include "summation.cuh"
 
 namespace sphere {
@@ -77,12 +78,17 @@ struct pair_tile {
     /// vectors were 0-5% faster than tiles of two, and in mixed two were 7% faster than one
     /// (docs/performance.md).
     static constexpr int width = 512 / sizeof(Real);
+    /// Lanes past width that the row walk in lanes may fill before the flush
+    /// (contact/separation_lanes.cuh), which then moves them to the front.
+    static constexpr int overflow = 8;
     int count = 0;
-    unsigned owner[width], partner[width], entry[width];
-    Real dx[width], dy[width], dz[width], r_i[width], r_j[width], excess[width]; ///< pair_separation
+    unsigned owner[width + overflow], partner[width + overflow], entry[width + overflow];
+    Real hw[width + overflow]; ///< the sliding flag, then the flags after the step
+    Real dx[width + overflow], dy[width + overflow], dz[width + overflow]; ///< pair_separation
+    Real r_i[width + overflow], r_j[width + overflow], excess[width + overflow];
     Real fx[width], fy[width], fz[width];
     Real tix[width], tiy[width], tiz[width], tjx[width], tjy[width], tjz[width];
-    Real hx[width], hy[width], hz[width], hw[width];
+    Real hx[width], hy[width], hz[width];
     Real hl[Lanes > 0 ? Lanes : 1][width];
     Real fn[width], visc[width], fric[width];
     Real rx[width], ry[width], rz[width], rw[width];
@@ -125,7 +131,7 @@ struct slab_pairs {
     void operator()(unsigned first_rank, unsigned end_rank) const
     {
         tile t;
-        unsigned apart[tile::width]; // entries of pairs that do not touch
+        unsigned apart[tile::width + tile::overflow]; // entries of pairs that do not touch
         int apart_count = 0;
         // Locals: the stores into the tile could alias the fields of *this, which the loop
         // would otherwise reload for every entry.
@@ -137,6 +143,13 @@ struct slab_pairs {
         for (unsigned r = first_rank; r < end_rank; ++r) {
             const unsigned i = static_cast<unsigned>(c.slot(r));
             const vec4<Coord> xi = x[i];
+#ifdef SPHERE_LANE_RECORDS
+            if constexpr (row_walk_in_lanes<Coord>) {
+                walk_in_lanes(i, xi, c.offset[r], c.offset[r + 1], t, apart, apart_count);
+                if (!near_only) walk_in_lanes(i, xi, c.far_begin(r), c.far_end(r), t, apart, apart_count);
+                continue;
+            }
+#endif
             // `image`: whether the row's separations need the nearest image (images_inside)
             const auto pair = [&](unsigned e, unsigned j, auto image) {
                 t.owner[t.count] = i;
@@ -186,6 +199,45 @@ private:
     static constexpr unsigned lanes = law_history_shape<Law>::value.lanes;
     using tile = pair_tile<Real, lanes>;
     static constexpr bool records = sums_in_records<Real>;
+
+#ifdef SPHERE_LANE_RECORDS
+    /// The pairs of owner i (at xi) in entries [e, end) of one of its rows, which lie within no
+    /// periodic face's reach, into the tile and the list of pairs apart, eight entries at a
+    /// time (lanes::separate_block): the same lanes, in the same order, as pair() one by one.
+    SPHERE_HDI void walk_in_lanes(unsigned i, const vec4<Coord>& xi, unsigned e, unsigned end, tile& t,
+                                  unsigned* apart, int& apart_count) const
+    {
+        for (; e < end; e += 8) {
+            const int n = end - e < 8 ? int(end - e) : 8;
+            lanes::separate_block<Law, wide>(eval.params, eval.box, eval.p.x, c.partner, c.history.flags, i, xi, e, n, t,
+                                             apart, apart_count);
+            if (apart_count >= tile::width) forget(apart, apart_count);
+            if (t.count >= tile::width) flush_overflowing(t);
+        }
+    }
+
+    /// Flushes the tile's first width lanes and moves the lanes past them to the front.
+    __attribute__((noinline)) void flush_overflowing(tile& t) const
+    {
+        const int over = t.count - tile::width;
+        t.count = tile::width;
+        flush(t);
+        for (int k = 0; k < over; ++k) {
+            const int from = tile::width + k;
+            t.owner[k] = t.owner[from];
+            t.partner[k] = t.partner[from];
+            t.entry[k] = t.entry[from];
+            t.hw[k] = t.hw[from];
+            t.dx[k] = t.dx[from];
+            t.dy[k] = t.dy[from];
+            t.dz[k] = t.dz[from];
+            t.r_i[k] = t.r_i[from];
+            t.r_j[k] = t.r_j[from];
+            if constexpr (wide) t.excess[k] = t.excess[from];
+        }
+        t.count = over;
+    }
+#endif
 
     /// The entries of pairs that do not touch: no force, and the history is forgotten.
     void forget(const unsigned* entry, int& count) const

@@ -9,7 +9,8 @@
 /// value (contact/interact.cuh).
 #include "../core/vec.cuh"
 
-#if defined(__AVX512F__) && defined(__AVX512DQ__) && defined(__AVX512VL__) && !defined(__CUDA_ARCH__)
+#if defined(__AVX512F__) && defined(__AVX512BW__) && defined(__AVX512DQ__) && defined(__AVX512VL__) && \
+    !defined(__CUDA_ARCH__)
 #define SPHERE_LANE_RECORDS 1
 #include <immintrin.h>
 #endif
