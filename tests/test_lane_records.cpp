@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <cstring>
 #include <random>
+#include <utility>
 #include <vector>
 
 // This file's tests and helpers in a namespace of their own: the test sources are compiled
@@ -145,10 +146,11 @@ bool same_value_bits(T a, T b)
     return std::memcmp(&a, &b, sizeof a) == 0;
 }
 
-/// Rows of 1 to 17 entries of random partners among particles in a box periodic in x and y
-/// (many near its faces, some at the same place as the owner, rows ending with wall codes),
-/// walked by lanes::separate_block and by separate<Law> entry by entry: the same lanes, apart
-/// entries and counts, to the bit, across tile flushes.
+/// Rows of 0 to 17 entries of random partners among particles in a box periodic in x and y
+/// (many near its faces, some at the same place as the owner, some rows ending with wall
+/// codes), one after the other, walked by lanes::separate_rows (blocks of eight entries across
+/// rows) and by separate<Law> entry by entry: the same lanes, apart entries and counts, to the
+/// bit, across tile flushes.
 template <class Law, class Real>
 void check_row_walk(const gap_params& params, std::uint32_t seed)
 {
@@ -169,16 +171,14 @@ void check_row_walk(const gap_params& params, std::uint32_t seed)
         }
         p.w = radius(rng);
     }
-    // partners near their owners, so that many pairs touch or nearly do
-    std::vector<unsigned> partner;
+    // rows of random owners; partners near their owners, so that many pairs touch or nearly do
+    std::vector<unsigned> partner, owner_of_row, row{0};
     std::vector<std::uint8_t> flags;
-    std::vector<unsigned> owner_of_row, row_start;
-    std::uniform_int_distribution<int> length(1, 17), walls(0, 3), any(0, n - 1), flag(0, 255);
-    for (int row = 0; row < 1500; ++row) {
+    std::uniform_int_distribution<int> length(0, 17), walls(0, 3), any(0, n - 1), flag(0, 255);
+    for (int r = 0; r < 1500; ++r) {
         const unsigned i = unsigned(any(rng));
         owner_of_row.push_back(i);
-        row_start.push_back(unsigned(partner.size()));
-        const int len = length(rng), wall_count = walls(rng) == 0 ? 2 : 0;
+        const int len = length(rng) < 3 ? 0 : length(rng), wall_count = walls(rng) == 0 ? 2 : 0;
         for (int k = 0; k < len; ++k) {
             const unsigned j = unsigned(any(rng));
             if (k % 3 != 0) { // place j touching i (its image across a face, where i lies near one)
@@ -195,27 +195,17 @@ void check_row_walk(const gap_params& params, std::uint32_t seed)
             partner.push_back(sphere::wall_partner_base + unsigned(f));
             flags.push_back(0);
         }
+        row.push_back(unsigned(partner.size()));
     }
-    row_start.push_back(unsigned(partner.size()));
+    const unsigned rows = unsigned(owner_of_row.size());
 
-    using tile = sphere::detail::pair_tile<Real, 0>;
-    constexpr bool wide = !std::is_same_v<Real, double>;
-    tile t;
-    std::vector<unsigned> apart(tile::width + tile::overflow);
-    int apart_count = 0;
     // the reference: entry by entry, as the scalar walk fills the tile
-    std::vector<unsigned> ref_entry, ref_apart, got_entry, got_apart;
-    std::vector<Real> ref_values, got_values;
-    const auto take_tile = [&](int count, std::vector<unsigned>& entries, std::vector<Real>& values) {
-        for (int k = 0; k < count; ++k) {
-            entries.insert(entries.end(), {t.owner[k], t.partner[k], t.entry[k]});
-            values.insert(values.end(), {t.hw[k], t.dx[k], t.dy[k], t.dz[k], t.r_i[k], t.r_j[k]});
-            if (wide) values.push_back(t.excess[k]);
-        }
-    };
-    for (std::size_t row = 0; row + 1 < row_start.size(); ++row) {
-        const unsigned i = owner_of_row[row];
-        for (unsigned e = row_start[row]; e < row_start[row + 1]; ++e) {
+    constexpr bool wide = !std::is_same_v<Real, double>;
+    std::vector<unsigned> ref_entry, ref_apart;
+    std::vector<Real> ref_values;
+    for (unsigned r = 0; r < rows; ++r) {
+        const unsigned i = owner_of_row[r];
+        for (unsigned e = row[r]; e < row[r + 1]; ++e) {
             const unsigned j = partner[e];
             if (j >= sphere::wall_partner_base) break;
             sphere::detail::pair_separation<Real> s;
@@ -225,29 +215,43 @@ void check_row_walk(const gap_params& params, std::uint32_t seed)
                 if (wide) ref_values.push_back(s.excess);
             } else ref_apart.push_back(e);
         }
-        // the lanes, flushed as the slab schedule flushes them
-        for (unsigned e = row_start[row]; e < row_start[row + 1]; e += 8) {
-            const int lanes = int(std::min(8u, row_start[row + 1] - e));
-            sphere::lanes::separate_block<Law, wide>(params, box, x.data(), partner.data(), flags.data(), i, x[i], e,
-                                                     lanes, t, apart.data(), apart_count);
-            if (apart_count >= tile::width) {
-                got_apart.insert(got_apart.end(), apart.begin(), apart.begin() + apart_count);
-                apart_count = 0;
-            }
-            if (t.count >= tile::width) {
-                take_tile(tile::width, got_entry, got_values);
-                const int over = t.count - tile::width;
-                for (int k = 0; k < over; ++k) {
-                    const int from = tile::width + k;
-                    t.owner[k] = t.owner[from], t.partner[k] = t.partner[from], t.entry[k] = t.entry[from];
-                    t.hw[k] = t.hw[from], t.dx[k] = t.dx[from], t.dy[k] = t.dy[from], t.dz[k] = t.dz[from];
-                    t.r_i[k] = t.r_i[from], t.r_j[k] = t.r_j[from], t.excess[k] = t.excess[from];
-                }
-                t.count = over;
-            }
-        }
     }
-    take_tile(t.count, got_entry, got_values);
+
+    // the lanes, emptied as the slab schedule flushes them, in two calls (a task's ranges)
+    using tile = sphere::detail::pair_tile<Real, 0>;
+    tile t;
+    std::vector<unsigned> apart(tile::width + tile::overflow), got_entry, got_apart;
+    std::vector<Real> got_values;
+    int apart_count = 0;
+    const auto take_tile = [&](int count) {
+        for (int k = 0; k < count; ++k) {
+            got_entry.insert(got_entry.end(), {t.owner[k], t.partner[k], t.entry[k]});
+            got_values.insert(got_values.end(), {t.hw[k], t.dx[k], t.dy[k], t.dz[k], t.r_i[k], t.r_j[k]});
+            if (wide) got_values.push_back(t.excess[k]);
+        }
+    };
+    const auto after_block = [&] {
+        if (apart_count >= tile::width) {
+            got_apart.insert(got_apart.end(), apart.begin(), apart.begin() + apart_count);
+            apart_count = 0;
+        }
+        if (t.count >= tile::width) {
+            take_tile(tile::width);
+            const int over = t.count - tile::width;
+            for (int k = 0; k < over; ++k) {
+                const int from = tile::width + k;
+                t.owner[k] = t.owner[from], t.partner[k] = t.partner[from], t.entry[k] = t.entry[from];
+                t.hw[k] = t.hw[from], t.dx[k] = t.dx[from], t.dy[k] = t.dy[from], t.dz[k] = t.dz[from];
+                t.r_i[k] = t.r_i[from], t.r_j[k] = t.r_j[from], t.excess[k] = t.excess[from];
+            }
+            t.count = over;
+        }
+    };
+    const auto slot_of = [&](unsigned r) { return owner_of_row[r]; };
+    for (const auto& [first, end] : {std::pair<unsigned, unsigned>{0, rows / 3}, {rows / 3, rows}})
+        sphere::lanes::separate_rows<Law, wide>(params, box, x.data(), partner.data(), flags.data(), row.data(), first,
+                                                end, slot_of, t, apart.data(), apart_count, after_block);
+    take_tile(t.count);
     got_apart.insert(got_apart.end(), apart.begin(), apart.begin() + apart_count);
     // both outcomes are common, and the lists are long enough to flush several tiles
     CHECK(ref_entry.size() / 3 > std::size_t(2 * tile::width));

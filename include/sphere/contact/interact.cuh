@@ -140,16 +140,22 @@ struct slab_pairs {
         const auto* const flags = c.history.flags;
         const world<Coord> box = eval.box;
         const auto params = eval.params;
+#ifdef SPHERE_LANE_RECORDS
+        if constexpr (row_walk_in_lanes<Coord>) {
+            if (near_only) walk_in_lanes(c.offset, first_rank, end_rank, t, apart, apart_count);
+            else
+                for (unsigned r = first_rank; r < end_rank; ++r) { // each near row, then its far row
+                    walk_in_lanes(c.offset, r, r + 1, t, apart, apart_count);
+                    walk_in_lanes(c.offset + c.n, r, r + 1, t, apart, apart_count);
+                }
+            if (t.count) flush(t);
+            forget(apart, apart_count);
+            return;
+        }
+#endif
         for (unsigned r = first_rank; r < end_rank; ++r) {
             const unsigned i = static_cast<unsigned>(c.slot(r));
             const vec4<Coord> xi = x[i];
-#ifdef SPHERE_LANE_RECORDS
-            if constexpr (row_walk_in_lanes<Coord>) {
-                walk_in_lanes(i, xi, c.offset[r], c.offset[r + 1], t, apart, apart_count);
-                if (!near_only) walk_in_lanes(i, xi, c.far_begin(r), c.far_end(r), t, apart, apart_count);
-                continue;
-            }
-#endif
             // `image`: whether the row's separations need the nearest image (images_inside)
             const auto pair = [&](unsigned e, unsigned j, auto image) {
                 t.owner[t.count] = i;
@@ -201,19 +207,18 @@ private:
     static constexpr bool records = sums_in_records<Real>;
 
 #ifdef SPHERE_LANE_RECORDS
-    /// The pairs of owner i (at xi) in entries [e, end) of one of its rows, which lie within no
-    /// periodic face's reach, into the tile and the list of pairs apart, eight entries at a
-    /// time (lanes::separate_block): the same lanes, in the same order, as pair() one by one.
-    SPHERE_HDI void walk_in_lanes(unsigned i, const vec4<Coord>& xi, unsigned e, unsigned end, tile& t,
+    /// The pairs of the rows of ranks [first_rank, end_rank), row r holding the entries
+    /// [row[r], row[r + 1]), into the tile and the list of pairs apart, eight entries at a time
+    /// (lanes::separate_rows): the same lanes, in the same order, as pair() one by one.
+    SPHERE_HDI void walk_in_lanes(const unsigned* row, unsigned first_rank, unsigned end_rank, tile& t,
                                   unsigned* apart, int& apart_count) const
     {
-        for (; e < end; e += 8) {
-            const int n = end - e < 8 ? int(end - e) : 8;
-            lanes::separate_block<Law, wide>(eval.params, eval.box, eval.p.x, c.partner, c.history.flags, i, xi, e, n, t,
-                                             apart, apart_count);
-            if (apart_count >= tile::width) forget(apart, apart_count);
-            if (t.count >= tile::width) flush_overflowing(t);
-        }
+        lanes::separate_rows<Law, wide>(
+            eval.params, eval.box, eval.p.x, c.partner, c.history.flags, row, first_rank, end_rank,
+            [this](unsigned r) { return static_cast<unsigned>(c.slot(r)); }, t, apart, apart_count, [&] {
+                if (apart_count >= tile::width) forget(apart, apart_count);
+                if (t.count >= tile::width) flush_overflowing(t);
+            });
     }
 
     /// Flushes the tile's first width lanes and moves the lanes past them to the front.
