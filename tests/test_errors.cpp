@@ -498,22 +498,24 @@ TEMPLATE_TEST_CASE("contact lists hold every partner they find, at setup and dur
     }
 }
 
-TEMPLATE_TEST_CASE("a particle leaving the world during the run names the step and the particle",
-                   "[errors][run][world]", float, double)
+/// A particle leaving the world during a run with `Integrator` (velocity Verlet checks the
+/// particles in its drift, at the start of a step; semi-implicit Euler at the end).
+template <class Real, class Integrator>
+void check_leaving_world()
 {
-    using Real = TestType;
+    using sim_type = sphere::simulation<Real, sphere::host, sphere::contact::linear<>, Integrator>;
     auto s = sphere_test::box_settings<Real>();
     auto ps = three<Real>();
     // Particle 1 at (0, 0.05, 0) flies towards the +y wall (at 0.1 m) at 1000 m/s: 0.024 m
     // per step, so it passes through in a few steps (the wall's spring, k_n delta ~ 1e3 N on
     // 0.01 kg, changes its velocity by ~2 m/s per step: negligible).
     ps[1].velocity = {0, Real(1000), 0};
-    const double dt = double(sphere::simulation<Real>(s, ps).dt());
+    const double dt = double(sim_type(s, ps).dt());
     const double steps_out = (0.1 - 0.05) / (1000 * dt); // 2.06
     REQUIRE(steps_out - std::floor(steps_out) > 0.03);
     const std::size_t n = static_cast<std::size_t>(std::floor(steps_out)) + 1; // 3
     auto run = [&] {
-        sphere::simulation<Real> sim(s, ps);
+        sim_type sim(s, ps);
         sim.run(10);
     };
     REQUIRE_SPHERE_ERROR(run(), Contains("step " + std::to_string(n) + ": particle 1 left the world: position (0, ") &&
@@ -522,14 +524,21 @@ TEMPLATE_TEST_CASE("a particle leaving the world during the run names the step a
                                              ", " + fmt(s.box.hi.z) + "] m"));
     // On a periodic axis the same particle re-enters at the other side.
     s.box.axis[1] = sphere::boundary::periodic;
-    sphere::simulation<Real> sim(s, ps);
+    sim_type sim(s, ps);
     REQUIRE_NOTHROW(sim.run(10));
 }
 
-TEMPLATE_TEST_CASE("a non-finite state during the run names the step and the particle", "[errors][run]", float,
-                   double)
+TEMPLATE_TEST_CASE("a particle leaving the world during the run names the step and the particle",
+                   "[errors][run][world]", float, double)
 {
-    using Real = TestType;
+    SECTION("semi-implicit Euler") { check_leaving_world<TestType, sphere::integrate::semi_implicit_euler>(); }
+    SECTION("velocity Verlet") { check_leaving_world<TestType, sphere::integrate::velocity_verlet>(); }
+}
+
+/// A non-finite state during a run with `Integrator`.
+template <class Real, class Integrator>
+void check_non_finite_state()
+{
     // A velocity that overflows: a huge (finite) gravity and a time step that the stable
     // bound allows because the springs are extremely soft (bound 0.3 sqrt(m / k) = 3e4 s).
     // All axes are periodic, so the particle cannot leave the world first.
@@ -540,11 +549,18 @@ TEMPLATE_TEST_CASE("a non-finite state during the run names the step and the par
     s.dt = Real(1e4);
     s.gravity = {0, 0, -std::numeric_limits<Real>::max() / 2};
     auto run = [&] {
-        sphere::simulation<Real> sim(s, three<Real>());
+        sphere::simulation<Real, sphere::host, sphere::contact::linear<>, Integrator> sim(s, three<Real>());
         sim.run(3);
     };
     REQUIRE_SPHERE_ERROR(run(), Contains("step 1: particle 0 became non-finite (position (") &&
                                     Contains("inf") && Contains("reduce the time step"));
+}
+
+TEMPLATE_TEST_CASE("a non-finite state during the run names the step and the particle", "[errors][run]", float,
+                   double)
+{
+    SECTION("semi-implicit Euler") { check_non_finite_state<TestType, sphere::integrate::semi_implicit_euler>(); }
+    SECTION("velocity Verlet") { check_non_finite_state<TestType, sphere::integrate::velocity_verlet>(); }
 }
 
 TEMPLATE_TEST_CASE("set_velocity refuses non-finite values and fixed particles", "[errors][run]", float, double)

@@ -3,11 +3,14 @@
 // physics does not depend on the team is tested in test_determinism.cpp.
 #include <catch2/catch.hpp>
 
+#include <sphere/exec/algorithms.cuh>
 #include <sphere/exec/for_each.cuh>
 #include <sphere/exec/thread_governor.cuh>
 
 #include <omp.h>
 
+#include <algorithm>
+#include <cstdint>
 #include <cstdlib>
 #include <string>
 #include <vector>
@@ -131,6 +134,42 @@ TEST_CASE("host_team_limit caps the threads of the host loops", "[threads]")
     sphere::host_team_limit() = 0;
     CHECK(sphere::host_team() == 2);
     CHECK(most_seen() == 2);
+}
+
+TEST_CASE("the largest and the smallest of a host reduction, in lanes, on any team", "[threads]")
+{
+    // max_op and min_op combine a chunk's values in eight lanes (sphere::order_free): every
+    // length around the lanes and the chunks, with the extreme in the first lane, in the
+    // remainder after the last full group of eight, in the last chunk and repeated.
+    thread_state_guard guard;
+    omp_set_num_threads(2);
+    const std::size_t chunk = sphere::host_chunk;
+    for (std::size_t n : {std::size_t(1), std::size_t(2), std::size_t(8), std::size_t(9), std::size_t(17), chunk - 1,
+                          chunk, chunk + 1, 3 * chunk + 5, 20 * chunk - 3}) {
+        std::vector<double> values(n);
+        std::uint32_t state = 12345;
+        for (double& v : values) {
+            state = state * 1664525u + 1013904223u;
+            v = double(state % 1000) - 500; // in [-500, 500)
+        }
+        for (std::size_t at : {std::size_t(0), n - 1, n / 2, (n - 1) / 8 * 8, n > 3 ? n - 3 : std::size_t(0)}) {
+            std::vector<double> v = values;
+            v[at] = 1e9;
+            v[n - 1 - at] = -1e9;
+            const double* data = v.data();
+            const auto value = [data](std::size_t i) { return data[i]; };
+            for (int team : {1, 2}) {
+                sphere::host_team_limit() = team;
+                INFO("n = " << n << ", extremes at " << at << " and " << n - 1 - at << ", team of " << team);
+                CHECK(sphere::transform_reduce(sphere::host{}, n, value, -1e300, sphere::max_op{}) ==
+                      *std::max_element(v.begin(), v.end()));
+                CHECK(sphere::transform_reduce(sphere::host{}, n, value, 1e300, sphere::min_op{}) ==
+                      *std::min_element(v.begin(), v.end()));
+                CHECK(sphere::transform_reduce(sphere::host{}, n, value, 2e9, sphere::max_op{}) == 2e9); // init counts
+            }
+            sphere::host_team_limit() = 0;
+        }
+    }
 }
 
 TEST_CASE("thread_governor obeys OMP_NUM_THREADS and SPHERE_ADAPT_THREADS=0", "[threads]")

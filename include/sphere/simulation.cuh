@@ -951,7 +951,9 @@ private:
             if (drift_checked_) { // never in the all-free variant (step_with above)
                 if constexpr (!AllFree) for_each_index(Policy{}, n, drift);
             } else {
-                checked_into(drift, check(), &report->moved2);
+                transform_reduce_into(context_, n,
+                                      detail::drift_and_check<Precision, Integrator, External, AllFree>{drift, check()},
+                                      Coord(0), max_op{}, &report->moved2);
                 Coord moved2 = 0;
                 context_.read_back(&moved2, &report->moved2, 1, "the particle check after the drift", steps_ + 1);
                 judge(moved2, steps_ + 1, drift_margin_); // the margin as below: a restart decides alike

@@ -42,6 +42,12 @@ struct min_op {
     template <class T> SPHERE_HD T operator()(const T& a, const T& b) const { return b < a ? b : a; }
 };
 
+/// Whether op's result over a set of numbers is the same in any order (the largest, the
+/// smallest; NaN aside): host_reduce then combines a chunk's values in interleaved lanes, which
+/// the CPU overlaps, rather than in one chain of dependent operations.
+template <class Op>
+inline constexpr bool order_free = std::is_same_v<Op, max_op> || std::is_same_v<Op, min_op>;
+
 namespace detail {
 /// values[i] = f(i): a reduction's transform as a kernel of its own (CUDA).
 template <class T, class Transform>
@@ -57,7 +63,8 @@ inline std::size_t host_reduce_chunks(std::size_t n) { return (n + host_chunk - 
 /// init op f(0) op f(1) ... op f(n-1), in a fixed association order: in order within chunks of
 /// host_chunk indices (small enough to share n = 1e4 evenly between threads), then the chunks
 /// in order; `partial` holds host_reduce_chunks(n) values. For a number type T the values of a
-/// chunk are computed first, in a loop that may vectorise, and then combined in order.
+/// chunk are computed first, in a loop that may vectorise, and then combined in order, or for an
+/// order_free op in eight lanes, each of every eighth value, and then the lanes.
 template <class T, class Transform, class Op>
 T host_reduce(std::size_t n, const Transform& f, T init, Op op, T* partial)
 {
@@ -72,7 +79,19 @@ T host_reduce(std::size_t n, const Transform& f, T init, Op op, T* partial)
             T values[host_chunk];
             SPHERE_VECTORISE_LOOP
             for (std::size_t i = begin + 1; i < end; ++i) values[i - begin] = local(i);
-            for (std::size_t i = begin + 1; i < end; ++i) acc = op(acc, values[i - begin]);
+            if constexpr (order_free<Op>) {
+                constexpr int ways = 8;
+                T lane[ways];
+                for (int k = 0; k < ways; ++k) lane[k] = acc;
+                std::size_t i = begin + 1;
+                for (; i + ways <= end; i += ways)
+                    for (int k = 0; k < ways; ++k) lane[k] = op(lane[k], values[i - begin + k]);
+                for (; i < end; ++i) lane[0] = op(lane[0], values[i - begin]);
+                for (int k = 1; k < ways; ++k) lane[0] = op(lane[0], lane[k]);
+                acc = lane[0];
+            } else {
+                for (std::size_t i = begin + 1; i < end; ++i) acc = op(acc, values[i - begin]);
+            }
         } else {
             for (std::size_t i = begin + 1; i < end; ++i) acc = op(acc, local(i));
         }

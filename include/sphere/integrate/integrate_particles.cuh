@@ -145,9 +145,17 @@ struct drift_particles {
     SPHERE_HDI void operator()(std::size_t i) const
     {
         vec3<Coord> pos;
-        vec3<Real> v;
+        vec3<Real> v, w;
+        drift(i, pos, v, w);
+    }
+
+    /// Drifts particle i and stores it, leaving its new position, velocity and angular
+    /// velocity in `pos`, `v` and `w` too (drift_and_check checks them from there).
+    SPHERE_HDI void drift(std::size_t i, vec3<Coord>& pos, vec3<Real>& v, vec3<Real>& w) const
+    {
         drifted(i, pos, v);
-        vec3<Real> w = p.omega[i], angle{0, 0, 0}, a, alpha; // angles are turn_particles' (not stored here)
+        w = p.omega[i];
+        vec3<Real> angle{0, 0, 0}, a, alpha; // angles are turn_particles' (not stored here)
         accelerations<External>(p, i, kind_of<AllFree>(p, i), gravity, external, external_torque, a, alpha);
         Integrator::drift(angle, w, alpha, dt);
         p.x[i] = {pos.x, pos.y, pos.z, p.x[i].w};
@@ -195,13 +203,13 @@ struct check_particle {
     world<Coord> box;
     wall_set<Coord> walls;
 
-    SPHERE_HDI bool bad(std::size_t i) const { return bad_at(i, p.x[i].xyz()); }
+    SPHERE_HDI bool bad(std::size_t i) const { return bad_at(p.x[i].xyz(), p.v_sync[i], p.omega_sync[i]); }
 
-    /// bad(i), were particle i at `pos`.
-    SPHERE_HDI bool bad_at(std::size_t i, const vec3<Coord>& pos) const
+    /// Whether a particle at `pos` (m) with synchronous velocity `v` (m/s) and angular velocity
+    /// `w` (rad/s) fails the check.
+    SPHERE_HDI bool bad_at(const vec3<Coord>& pos, const vec3<real_t<P>>& v, const vec3<real_t<P>>& w) const
     {
-        const bool position_finite = isfinite(pos), velocity_finite = isfinite(p.v_sync[i]),
-                   spin_finite = isfinite(p.omega_sync[i]);
+        const bool position_finite = isfinite(pos), velocity_finite = isfinite(v), spin_finite = isfinite(w);
         bool out = !(position_finite & velocity_finite & spin_finite);
         for (int a = 0; a < 3; ++a) {
             const Coord c = pos[a];
@@ -212,10 +220,11 @@ struct check_particle {
         return out;
     }
 
-    SPHERE_HDI Coord operator()(std::size_t i) const { return at(i, p.x[i].xyz()); }
+    SPHERE_HDI Coord operator()(std::size_t i) const { return at(i, p.x[i].xyz(), p.v_sync[i], p.omega_sync[i]); }
 
-    /// The check of particle i, were it at `pos` (wrapped into the box).
-    SPHERE_HDI Coord at(std::size_t i, const vec3<Coord>& pos) const
+    /// The check of particle i, were it at `pos` (wrapped into the box) with synchronous
+    /// velocity `v` and angular velocity `w`.
+    SPHERE_HDI Coord at(std::size_t i, const vec3<Coord>& pos, const vec3<real_t<P>>& v, const vec3<real_t<P>>& w) const
     {
         // Written so that the displacement is computed whatever the outcome (the compiler
         // cannot load fields conditionally in SIMD lanes): a NaN becomes +infinity, and a bad
@@ -223,7 +232,7 @@ struct check_particle {
         const Coord inf = infinity<Coord>;
         Coord moved = norm2(box.nearest_image_inside(pos - lattice.decode(x_at_build[i]))); // both wrapped
         moved = moved == moved ? moved : inf;
-        const Coord flag = bad_at(i, pos) ? inf : Coord(0);
+        const Coord flag = bad_at(pos, v, w) ? inf : Coord(0);
         return moved > flag ? moved : flag;
     }
 };
@@ -240,7 +249,24 @@ struct check_after_drift {
         vec3<coord_t<P>> pos;
         vec3<real_t<P>> v;
         drift.drifted(i, pos, v);
-        return check.at(i, pos);
+        return check.at(i, pos, check.p.v_sync[i], check.p.omega_sync[i]); // the velocities before the drift
+    }
+};
+
+/// Drifts particle i (drift_particles) and returns its check (check_particle) at the position
+/// and velocities the drift has just stored, from the drift's registers: a check after the
+/// drift as a separate body (then_check) loads them again, and the compiler cannot know that
+/// the stores and loads name the same memory (the loop then transposes every field twice).
+template <class P, class Integrator, bool External, bool AllFree>
+struct drift_and_check {
+    drift_particles<P, Integrator, External, AllFree> drift;
+    check_particle<P> check;
+    SPHERE_HDI coord_t<P> operator()(std::size_t i) const
+    {
+        vec3<coord_t<P>> pos;
+        vec3<real_t<P>> v, w;
+        drift.drift(i, pos, v, w);
+        return check.at(i, pos, v, w);
     }
 };
 
