@@ -43,7 +43,7 @@ struct min_op {
 };
 
 /// Whether op's result over a set of numbers is the same in any order (the largest, the
-/// smallest; NaN aside): host_reduce then combines a chunk's values in interleaved lanes, which
+/// smallest; NaN and the sign of zero aside): host_reduce then combines a chunk's values in interleaved lanes, which
 /// the CPU overlaps, rather than in one chain of dependent operations.
 template <class Op>
 inline constexpr bool order_free = std::is_same_v<Op, max_op> || std::is_same_v<Op, min_op>;
